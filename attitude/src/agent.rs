@@ -1,0 +1,210 @@
+//! One follower as a stage-by-stage stepper: the unit every engine runs.
+//!
+//! The protocol, identical in every engine:
+//! 1. at an exchange (see [`Coupling::exchanges_at`](crate::network::Coupling::exchanges_at)),
+//!    every node publishes [`Agent::stage_exchange`] and every receiver
+//!    stores what it got with [`Agent::receive_neighbour`] /
+//!    [`Agent::receive_leader`];
+//! 2. every node calls [`Agent::advance`], which evaluates its vector field
+//!    at its own current stage state and the last values it holds.
+//!
+//! Because the arithmetic depends only on the agent's own state and the held
+//! values, an agent computes bit-identical results in any process.
+
+use crate::body::omega_dot;
+use crate::control::{tau_control, tau_control_constant_estimate, tau_districontrol, tracking_error};
+use crate::integrate::{LieDerivative, LieState, Rkmk4};
+use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
+use crate::observer::{
+    LeaderInput, omega_hat_dot_7b, omega_hat_dot_16b, r_hat_rate, sigma_hat_dot_7c,
+};
+use nalgebra::{Matrix3, Vector3};
+
+/// The closed-loop vector field of agent i and the torque it applies.
+///
+/// Scheme 1: eqs. `followeri`, `7a`–`7c`, `control`. Scheme 2: eqs.
+/// `followeri`, `16a`–`16b`, `controlconstantestimate`. Scheme 3: eqs.
+/// `followeri`, `districontrol`. `nbrs` are in the order of
+/// `model.neighbours`; `leader` is `Some` iff the agent hears the leader.
+#[must_use]
+pub fn agent_field(
+    model: &AgentModel,
+    gains: &[Matrix3<f64>],
+    x: &AgentState,
+    nbrs: &[Exchanged],
+    leader: Option<&Exchanged>,
+) -> (AgentDerivative, Vector3<f64>) {
+    let leader = match (leader, &model.leader_gain) {
+        (Some(x), Some(a)) => Some(LeaderInput { a, x }),
+        _ => None,
+    };
+    let own = exchanged_of(&model.scheme, x);
+    let (w_hat_dot, s_hat_dot, tau) = match &model.scheme {
+        Scheme::ObserverTimeVarying { observer, control } => {
+            let w_hat_dot = omega_hat_dot_7b(observer, &own, gains, nbrs, leader);
+            let s_hat_dot = sigma_hat_dot_7c(observer, &model.p, &own, nbrs, leader);
+            let e = tracking_error(&x.r, &x.w, &x.r_hat, &x.w_hat);
+            let tau = tau_control(control, &model.inertia, &model.a_bar, &e, &w_hat_dot);
+            (w_hat_dot, s_hat_dot, tau)
+        }
+        Scheme::ObserverConstant { observer, control } => {
+            let w_hat_dot = omega_hat_dot_16b(observer, &own, gains, nbrs, leader);
+            let e = tracking_error(&x.r, &x.w, &x.r_hat, &x.w_hat);
+            let tau = tau_control_constant_estimate(
+                control,
+                &model.inertia,
+                &model.a_bar,
+                &e,
+                &w_hat_dot,
+            );
+            (w_hat_dot, Vector3::zeros(), tau)
+        }
+        Scheme::Observerless { control } => {
+            let tau = tau_districontrol(control, &x.r, &x.w, gains, nbrs, leader);
+            (Vector3::zeros(), Vector3::zeros(), tau)
+        }
+    };
+    let r_hat_w = if model.scheme.has_observer() {
+        r_hat_rate(&own)
+    } else {
+        Vector3::zeros()
+    };
+    let d = LieDerivative {
+        omega: [x.w, r_hat_w],
+        vec: [omega_dot(&model.inertia, &x.w, &tau), w_hat_dot, s_hat_dot],
+    };
+    (d, tau)
+}
+
+/// Tangent vector of an agent's state: rates of `(Rᵢ, R̂ᵢ)` and `(ωᵢ, ω̂ᵢ, σ̂ᵢ)`.
+pub type AgentDerivative = LieDerivative<2, 3>;
+
+/// What agent i publishes under `scheme`: `(R̂ᵢ, ω̂ᵢ, σ̂ᵢ)` with an observer,
+/// `(Rᵢ, ωᵢ, 0)` without.
+#[must_use]
+pub fn exchanged_of(scheme: &Scheme, x: &AgentState) -> Exchanged {
+    if scheme.has_observer() {
+        Exchanged {
+            r: x.r_hat,
+            w: x.w_hat,
+            s: x.s_hat,
+        }
+    } else {
+        Exchanged {
+            r: x.r,
+            w: x.w,
+            s: Vector3::zeros(),
+        }
+    }
+}
+
+fn to_lie(x: &AgentState) -> LieState<2, 3> {
+    LieState {
+        rot: [x.r, x.r_hat],
+        vec: [x.w, x.w_hat, x.s_hat],
+    }
+}
+
+fn from_lie(y: &LieState<2, 3>) -> AgentState {
+    AgentState {
+        r: y.rot[0],
+        w: y.vec[0],
+        r_hat: y.rot[1],
+        w_hat: y.vec[1],
+        s_hat: y.vec[2],
+    }
+}
+
+/// A follower stepping its closed loop with RKMK4, stage by stage.
+#[derive(Debug, Clone)]
+pub struct Agent {
+    model: AgentModel,
+    gains: Vec<Matrix3<f64>>,
+    state: AgentState,
+    step: Rkmk4<2, 3>,
+    dt: f64,
+    held_nbrs: Vec<Exchanged>,
+    held_leader: Option<Exchanged>,
+    peak_torque: f64,
+}
+
+impl Agent {
+    /// An agent with `model`, starting at `initial`, step `dt` (s).
+    #[must_use]
+    pub fn new(model: AgentModel, initial: AgentState, dt: f64) -> Self {
+        let gains = model.neighbours.iter().map(|n| n.a).collect();
+        let held_nbrs = vec![Exchanged::identity(); model.neighbours.len()];
+        let held_leader = model.leader_gain.map(|_| Exchanged::identity());
+        Self {
+            model,
+            gains,
+            state: initial,
+            step: Rkmk4::new(to_lie(&initial), dt),
+            dt,
+            held_nbrs,
+            held_leader,
+            peak_torque: 0.0,
+        }
+    }
+
+    /// The agent's model.
+    #[must_use]
+    pub fn model(&self) -> &AgentModel {
+        &self.model
+    }
+
+    /// State at the start of the current step.
+    #[must_use]
+    pub fn state(&self) -> &AgentState {
+        &self.state
+    }
+
+    /// Largest `‖τᵢ‖` applied at the start of any step so far, N·m.
+    #[must_use]
+    pub fn peak_torque(&self) -> f64 {
+        self.peak_torque
+    }
+
+    /// What the agent publishes at the current stage.
+    #[must_use]
+    pub fn stage_exchange(&self) -> Exchanged {
+        exchanged_of(&self.model.scheme, &from_lie(&self.step.stage_state()))
+    }
+
+    /// Stores the value received from the `k`-th neighbour (order of `model.neighbours`).
+    pub fn receive_neighbour(&mut self, k: usize, x: Exchanged) {
+        self.held_nbrs[k] = x;
+    }
+
+    /// Stores the value received from the leader (ignored if not connected).
+    pub fn receive_leader(&mut self, x: Exchanged) {
+        if let Some(h) = &mut self.held_leader {
+            *h = x;
+        }
+    }
+
+    /// Evaluates the current stage with the held inputs and moves on.
+    /// Returns `true` when a step completed.
+    pub fn advance(&mut self) -> bool {
+        let stage = self.step.stage();
+        let x = from_lie(&self.step.stage_state());
+        let (d, tau) = agent_field(
+            &self.model,
+            &self.gains,
+            &x,
+            &self.held_nbrs,
+            self.held_leader.as_ref(),
+        );
+        if stage == 0 {
+            self.peak_torque = self.peak_torque.max(tau.norm());
+        }
+        match self.step.push_derivative(&d) {
+            Some(next) => {
+                self.state = from_lie(&next);
+                self.step = Rkmk4::new(next, self.dt);
+                true
+            }
+            None => false,
+        }
+    }
+}

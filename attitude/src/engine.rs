@@ -1,0 +1,130 @@
+//! The in-process engine: every node in one loop, in lockstep.
+//!
+//! It runs exactly the protocol of [`crate::agent`] that the
+//! process-per-agent engine runs over shared memory, so both produce
+//! bit-identical trajectories.
+
+use crate::agent::Agent;
+use crate::network::{AgentState, Network};
+use crate::reference::{Leader, LeaderState};
+
+/// The network's state at an output sample.
+#[derive(Debug)]
+pub struct Snapshot<'a> {
+    /// Step index (t = step · dt).
+    pub step: u64,
+    /// Leader state.
+    pub leader: &'a LeaderState,
+    /// Agent states, in the order of `Network::agents`.
+    pub agents: &'a [AgentState],
+}
+
+/// All nodes of a network in one process.
+#[derive(Debug)]
+pub struct InProcess {
+    net: Network,
+    leader: Leader,
+    agents: Vec<Agent>,
+    /// For each agent, the index in `agents` of each neighbour.
+    nbr_index: Vec<Vec<usize>>,
+    step: u64,
+    states: Vec<AgentState>,
+}
+
+impl InProcess {
+    /// Builds the nodes of `net`.
+    #[must_use]
+    pub fn new(net: &Network) -> Self {
+        let leader = Leader::new(net.p, net.leader, net.dt);
+        let agents: Vec<Agent> = net
+            .agents
+            .iter()
+            .map(|a| Agent::new(a.model.clone(), a.initial, net.dt))
+            .collect();
+        let nbr_index = net
+            .agents
+            .iter()
+            .map(|a| {
+                a.model
+                    .neighbours
+                    .iter()
+                    .map(|n| net.index_of(n.id).expect("validated network"))
+                    .collect()
+            })
+            .collect();
+        let states = agents.iter().map(|a| *a.state()).collect();
+        Self {
+            net: net.clone(),
+            leader,
+            agents,
+            nbr_index,
+            step: 0,
+            states,
+        }
+    }
+
+    /// Steps done so far.
+    #[must_use]
+    pub fn step_index(&self) -> u64 {
+        self.step
+    }
+
+    /// The nodes' agents (for peak torques and models).
+    #[must_use]
+    pub fn agents(&self) -> &[Agent] {
+        &self.agents
+    }
+
+    /// The current state as a snapshot.
+    #[must_use]
+    pub fn snapshot(&self) -> Snapshot<'_> {
+        Snapshot {
+            step: self.step,
+            leader: self.leader.state(),
+            agents: &self.states,
+        }
+    }
+
+    /// Advances every node by one step (four stages, exchanging as the
+    /// coupling says).
+    pub fn step(&mut self) {
+        let mut published = Vec::with_capacity(self.agents.len());
+        for stage in 0..4 {
+            if self.net.coupling.exchanges_at(self.step, stage) {
+                let from_leader = self.leader.stage_exchange();
+                published.clear();
+                published.extend(self.agents.iter().map(Agent::stage_exchange));
+                for (agent, nbrs) in self.agents.iter_mut().zip(&self.nbr_index) {
+                    for (k, &j) in nbrs.iter().enumerate() {
+                        agent.receive_neighbour(k, published[j]);
+                    }
+                    agent.receive_leader(from_leader);
+                }
+            }
+            self.leader.advance();
+            for agent in &mut self.agents {
+                agent.advance();
+            }
+        }
+        self.step += 1;
+        for (s, a) in self.states.iter_mut().zip(&self.agents) {
+            *s = *a.state();
+        }
+    }
+
+    /// Runs to the end, calling `on_sample` at t = 0 and every
+    /// `sample_every` steps. Stops early if `on_sample` returns `false`.
+    pub fn run(&mut self, mut on_sample: impl FnMut(&Snapshot<'_>) -> bool) {
+        if self.step == 0 && !on_sample(&self.snapshot()) {
+            return;
+        }
+        while self.step < self.net.steps {
+            self.step();
+            if (self.step % self.net.sample_every == 0 || self.step == self.net.steps)
+                && !on_sample(&self.snapshot())
+            {
+                return;
+            }
+        }
+    }
+}

@@ -1,0 +1,33 @@
+//! Pure model of leader-follower attitude synchronisation of rigid bodies on
+//! SO(3), after "Leader-follower attitude synchronization of rigid-body
+//! systems on SO(3)" (equation labels in the docs are that paper's
+//! `\label{}` names; see `shared/paper/NOTES.md` for the plain notation and
+//! the errata this crate implements).
+//!
+//! No clock, no I/O, no transport: time and every input are parameters.
+//!
+//! # Layout
+//! - [`so3`]: hat, vex, ψ, exp, log, `Rot(θ,u)`, `|R|_I`, `dexp⁻¹`.
+//! - [`integrate`]: RKMK4 on SO(3)ⁿ × ℝ³ᵐ, driven stage by stage.
+//! - [`body`]: rigid-body dynamics (eq. `followeri`).
+//! - [`reference`]: the leader (eq. `leader`).
+//! - [`observer`]: eqs. `7a`–`7c`, `16a`–`16b`.
+//! - [`control`]: eqs. `control` (corrected `sigmai`, `gammai`),
+//!   `controlconstantestimate`, `districontrol`.
+//! - [`network`]: the resolved network every engine runs.
+//! - [`agent`]: one follower as a stage-by-stage stepper (the exchange protocol).
+//! - [`engine`]: all nodes in one process, in lockstep.
+//! - [`metrics`]: the reported errors.
+//! - [`checks`]: the paper's conditions on gains and on `P`.
+
+pub mod agent;
+pub mod body;
+pub mod checks;
+pub mod control;
+pub mod engine;
+pub mod integrate;
+pub mod metrics;
+pub mod network;
+pub mod observer;
+pub mod reference;
+pub mod so3;

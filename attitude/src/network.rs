@@ -1,0 +1,180 @@
+//! The network as the model sees it: who talks to whom, with which gains,
+//! from which initial state, and how often states are exchanged.
+//!
+//! This is the resolved form of a scenario (rotations as matrices, gains as
+//! matrices, neighbours sorted by id). Every engine builds its nodes from it.
+
+use crate::body::Inertia;
+use crate::control::ControlGains;
+use crate::observer::ObserverGains;
+use crate::reference::LeaderState;
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+
+/// What one node makes known to its neighbours at an exchange: an attitude,
+/// an angular velocity and an angular acceleration.
+///
+/// Which state it is depends on the scheme: the observer estimate
+/// `(R̂ⱼ, ω̂ⱼ, σ̂ⱼ)` for schemes 1–2, the body `(Rⱼ, ωⱼ, 0)` for the
+/// observerless scheme, `(R₀, ω₀, σ₀)` for the leader.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Exchanged {
+    /// Attitude (body → inertial).
+    pub r: Matrix3<f64>,
+    /// Body angular velocity, rad/s.
+    pub w: Vector3<f64>,
+    /// Angular acceleration, rad/s².
+    pub s: Vector3<f64>,
+}
+
+impl Exchanged {
+    /// Identity attitude, zero rates: the value before anything is received.
+    #[must_use]
+    pub fn identity() -> Self {
+        Self {
+            r: Matrix3::identity(),
+            w: Vector3::zeros(),
+            s: Vector3::zeros(),
+        }
+    }
+}
+
+/// The paper's three schemes and their gains.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Scheme {
+    /// Scheme 1 (Section `timevarying`): observer `7a`–`7c` + law `control`.
+    ObserverTimeVarying {
+        /// `k_{R^l}, k_{ω^l}, k_σ̃`.
+        observer: ObserverGains,
+        /// `k_R̄, k_ω̄`.
+        control: ControlGains,
+    },
+    /// Scheme 2 (Section `constant`): observer `16a`–`16b` + law `controlconstantestimate`.
+    ObserverConstant {
+        /// `k_{R^r}, k_{ω^r}` (`k_sigma` unused).
+        observer: ObserverGains,
+        /// `k_R̄, k_ω̄`.
+        control: ControlGains,
+    },
+    /// Scheme 3 (Section `constant`): law `districontrol`, no observer.
+    Observerless {
+        /// `k_Ř, k_ω̌`.
+        control: ControlGains,
+    },
+}
+
+impl Scheme {
+    /// Whether agents run an observer of the leader (schemes 1 and 2).
+    #[must_use]
+    pub fn has_observer(&self) -> bool {
+        !matches!(self, Scheme::Observerless { .. })
+    }
+}
+
+/// State of one agent: its body and its observer's estimate of the leader.
+/// The observer part stays constant (and unused) in the observerless scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AgentState {
+    /// `Rᵢ`, body → inertial.
+    pub r: Matrix3<f64>,
+    /// `ωᵢ`, body frame, rad/s.
+    pub w: Vector3<f64>,
+    /// `R̂ᵢ`.
+    pub r_hat: Matrix3<f64>,
+    /// `ω̂ᵢ`, rad/s.
+    pub w_hat: Vector3<f64>,
+    /// `σ̂ᵢ`, rad/s².
+    pub s_hat: Vector3<f64>,
+}
+
+/// A follower edge seen from one end: the neighbour's id and the gain `A_{i,j}`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Neighbour {
+    /// The neighbour's agent id.
+    pub id: u32,
+    /// `A_{i,j} = A_{j,i}` (or `Ǎ_{i,j}` for the observerless scheme).
+    pub a: Matrix3<f64>,
+}
+
+/// Everything agent i knows: its body, gains, neighbourhood and the shared
+/// scheme parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AgentModel {
+    /// Agent id (≥ 1; 0 is the leader).
+    pub id: u32,
+    /// Inertia `Jᵢ`.
+    pub inertia: Inertia,
+    /// Control gain matrix `Āᵢ` (schemes 1–2; unused by the observerless scheme).
+    pub a_bar: Matrix3<f64>,
+    /// Follower neighbours, sorted by id.
+    pub neighbours: Vec<Neighbour>,
+    /// `A_{i,0}` if the agent hears the leader (`Ξᵢ = 1`).
+    pub leader_gain: Option<Matrix3<f64>>,
+    /// Scheme and its gains (the same for every agent).
+    pub scheme: Scheme,
+    /// The leader's generator `P` (known to every observer, eq. `7c`).
+    pub p: Matrix3<f64>,
+}
+
+/// How often neighbours exchange states.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "mode", rename_all = "kebab-case")]
+pub enum Coupling {
+    /// At every integrator stage: the network is one centralised integration
+    /// of the continuous-time closed loop.
+    Continuous,
+    /// At the first stage of every `every`-th step; received values are held
+    /// in between (a digital network with period `every · dt`).
+    Sampled {
+        /// Exchange period in steps (≥ 1).
+        every: u64,
+    },
+}
+
+impl Coupling {
+    /// Whether nodes exchange states at stage `stage` (0..4) of step `step`.
+    #[must_use]
+    pub fn exchanges_at(&self, step: u64, stage: usize) -> bool {
+        match *self {
+            Coupling::Continuous => true,
+            Coupling::Sampled { every } => stage == 0 && step % every == 0,
+        }
+    }
+}
+
+/// One agent: its model and initial state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AgentSpec {
+    /// What the agent knows.
+    pub model: AgentModel,
+    /// State at t = 0.
+    pub initial: AgentState,
+}
+
+/// A whole network, resolved and validated, ready for any engine.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Network {
+    /// Agents, sorted by id.
+    pub agents: Vec<AgentSpec>,
+    /// Leader generator `P`.
+    pub p: Matrix3<f64>,
+    /// Leader state at t = 0.
+    pub leader: LeaderState,
+    /// Integrator step, s.
+    pub dt: f64,
+    /// Number of steps.
+    pub steps: u64,
+    /// Exchange schedule.
+    pub coupling: Coupling,
+    /// Output sample period, in steps.
+    pub sample_every: u64,
+}
+
+impl Network {
+    /// Index in `agents` of the agent with id `id`.
+    #[must_use]
+    pub fn index_of(&self, id: u32) -> Option<usize> {
+        self.agents.iter().position(|a| a.model.id == id)
+    }
+}
