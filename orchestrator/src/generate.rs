@@ -1,0 +1,165 @@
+//! Generated scenarios: `attsync gen tree` builds a random tree of agents
+//! with seeded, reproducible values (ChaCha8 stream).
+
+use crate::scenario::schema::{
+    AgentSpec, ControlGainsSpec, CouplingKind, EdgeSpec, LeaderLinkSpec, LeaderSpec, MatrixSpec,
+    ObserverGainsSpec, ObserverInit, Output, ReferenceKind, RotationSpec, Scenario, SchemeKind,
+    SchemeSpec, Simulation,
+};
+use rand::seq::index::sample;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Parameters of a random tree.
+#[derive(Debug, Clone)]
+pub struct TreeParams {
+    /// Number of agents (≥ 1).
+    pub agents: u32,
+    /// Number of agents that hear the leader (1..=agents).
+    pub leader_links: u32,
+    /// RNG seed.
+    pub seed: u64,
+    /// Scheme (gains are the paper's for that scheme).
+    pub scheme: SchemeKind,
+    /// Horizon, s.
+    pub duration: f64,
+}
+
+/// `P` of the paper's experiment: a decaying mode and an oscillating pair `±i/√2`.
+pub const PAPER_P: [[f64; 3]; 3] = [
+    [-1.0, 0.0, 0.0],
+    [0.0, 0.0, -0.7071067811865475],
+    [0.0, 0.7071067811865476, 0.0],
+];
+
+/// A random tree: agent k ≥ 2 attaches to a uniformly chosen agent < k;
+/// `leader_links` distinct agents hear the leader. Inertias, initial states
+/// and gain offsets are drawn uniformly; every gain matrix is
+/// `diag(c+m, c+1+m, c+2+m)` like the paper's, so it is SPD with distinct
+/// eigenvalues. The reference excites P's oscillating mode (σ₀(0) = [0.2, 1, 0]).
+pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
+    if p.agents == 0 {
+        return Err("--agents must be ≥ 1".into());
+    }
+    if p.leader_links == 0 || p.leader_links > p.agents {
+        return Err(format!("--leader-links must be in 1..={}", p.agents));
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+    let diag = |c: f64, m: f64| MatrixSpec::Diagonal([c + m, c + 1.0 + m, c + 2.0 + m]);
+    let has_obs = p.scheme != SchemeKind::Observerless;
+    let mut agents = Vec::new();
+    for id in 1..=p.agents {
+        let inertia = MatrixSpec::Diagonal([
+            rng.random_range(0.1..1.0),
+            rng.random_range(0.1..1.0),
+            rng.random_range(0.1..1.0),
+        ]);
+        let attitude = random_rotation(&mut rng);
+        let omega = random_vec(&mut rng, 1.0);
+        let control_gain = has_obs.then(|| diag(10.0, rng.random_range(0.0..5.0)));
+        let observer = has_obs.then(|| ObserverInit {
+            attitude: random_rotation(&mut rng),
+            omega: random_vec(&mut rng, 1.0),
+            sigma: (p.scheme == SchemeKind::ObserverTimeVarying).then(|| random_vec(&mut rng, 0.5)),
+        });
+        agents.push(AgentSpec {
+            id,
+            inertia,
+            attitude,
+            omega,
+            control_gain,
+            observer,
+        });
+    }
+    let (c_edge, c_link) = if has_obs { (10.0, 14.0) } else { (3.0, 5.0) };
+    let edges = (2..=p.agents)
+        .map(|k| EdgeSpec {
+            agents: [rng.random_range(1..k), k],
+            gain: diag(c_edge, rng.random_range(0.0..5.0)),
+        })
+        .collect();
+    let mut linked: Vec<u32> = sample(&mut rng, p.agents as usize, p.leader_links as usize)
+        .into_iter()
+        .map(|i| i as u32 + 1)
+        .collect();
+    linked.sort_unstable();
+    let leader_links = linked
+        .into_iter()
+        .map(|agent| LeaderLinkSpec {
+            agent,
+            gain: diag(c_link, rng.random_range(0.0..5.0)),
+        })
+        .collect();
+    let (scheme, leader) = match p.scheme {
+        SchemeKind::ObserverTimeVarying => (
+            SchemeSpec {
+                kind: p.scheme,
+                observer: Some(ObserverGainsSpec { k_r: 9.0, k_omega: 14.0, k_sigma: Some(12.0) }),
+                control: ControlGainsSpec { k_r: 8.0, k_omega: 13.0 },
+            },
+            LeaderSpec {
+                reference: ReferenceKind::TimeVarying,
+                p: Some(PAPER_P),
+                attitude: RotationSpec { axis: Some([1.0, 4.0, 2.0]), angle_pi: Some(0.8), ..Default::default() },
+                omega: Some([1.0, 2.0, 0.0]),
+                sigma: Some([0.2, 1.0, 0.0]),
+            },
+        ),
+        SchemeKind::ObserverConstant => (
+            SchemeSpec {
+                kind: p.scheme,
+                observer: Some(ObserverGainsSpec { k_r: 14.0, k_omega: 12.0, k_sigma: None }),
+                control: ControlGainsSpec { k_r: 13.0, k_omega: 11.0 },
+            },
+            constant_leader(),
+        ),
+        SchemeKind::Observerless => (
+            SchemeSpec {
+                kind: p.scheme,
+                observer: None,
+                control: ControlGainsSpec { k_r: 1.9, k_omega: 1.9 },
+            },
+            constant_leader(),
+        ),
+    };
+    Ok(Scenario {
+        name: Some(format!("tree-{}-{}-seed{}", p.agents, p.leader_links, p.seed)),
+        description: Some(format!(
+            "Random tree: {} agents, {} leader links, seed {} (attsync gen tree).",
+            p.agents, p.leader_links, p.seed
+        )),
+        simulation: Simulation { dt: 0.001, duration: p.duration, coupling: CouplingKind::Continuous, period: None },
+        output: Output::default(),
+        scheme,
+        leader,
+        leader_links,
+        agents,
+        edges,
+    })
+}
+
+fn constant_leader() -> LeaderSpec {
+    LeaderSpec {
+        reference: ReferenceKind::Constant,
+        p: None,
+        attitude: RotationSpec { axis: Some([1.0, 4.0, 2.0]), angle_pi: Some(0.8), ..Default::default() },
+        omega: None,
+        sigma: None,
+    }
+}
+
+fn random_vec(rng: &mut ChaCha8Rng, a: f64) -> [f64; 3] {
+    [rng.random_range(-a..a), rng.random_range(-a..a), rng.random_range(-a..a)]
+}
+
+fn random_rotation(rng: &mut ChaCha8Rng) -> RotationSpec {
+    let mut axis = random_vec(rng, 1.0);
+    if axis.iter().all(|x| x.abs() < 1e-3) {
+        axis = [0.0, 0.0, 1.0];
+    }
+    RotationSpec {
+        axis: Some(axis),
+        angle_deg: Some(rng.random_range(0.0..170.0)),
+        ..Default::default()
+    }
+}

@@ -1,0 +1,130 @@
+//! Run outputs: `errors.csv`, `summary.json`, `errors.svg`, `scenario.toml`,
+//! written atomically (see [`staging`]).
+
+pub mod plot;
+pub mod staging;
+pub mod summary;
+
+use attitude::engine::Snapshot;
+use attitude::metrics::errors;
+use attitude::network::Network;
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+pub use summary::{AgentSummary, Summary};
+
+/// The exact header of `errors.csv`.
+pub const CSV_HEADER: &str = "t,agent,att_err,angvel_err,obs_att_err,obs_angvel_err";
+
+/// Error time series of one agent, as sampled.
+#[derive(Debug, Clone, Default)]
+pub struct Series {
+    /// Agent id.
+    pub id: u32,
+    /// Sample times, s.
+    pub t: Vec<f64>,
+    /// `|Rᵢ R₀ᵀ|_I`.
+    pub att: Vec<f64>,
+    /// `‖ωᵢ − ω₀‖`.
+    pub angvel: Vec<f64>,
+    /// Observer errors (empty without an observer).
+    pub obs_att: Vec<f64>,
+    /// Observer angular-velocity errors.
+    pub obs_angvel: Vec<f64>,
+}
+
+/// Turns snapshots into `errors.csv` rows (streamed) and in-memory series.
+#[derive(Debug)]
+pub struct Recorder {
+    csv: BufWriter<File>,
+    dt: f64,
+    has_observer: bool,
+    series: Vec<Series>,
+}
+
+/// Formats a sample time `step · dt` without binary noise (9 decimals, trimmed).
+#[must_use]
+pub fn fmt_time(step: u64, dt: f64) -> String {
+    let s = format!("{:.9}", step as f64 * dt);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s.is_empty() { "0".into() } else { s.to_string() }
+}
+
+impl Recorder {
+    /// Starts `errors.csv` in `dir` for `net`.
+    pub fn new(dir: &Path, net: &Network) -> io::Result<Self> {
+        let mut csv = BufWriter::new(File::create(dir.join("errors.csv"))?);
+        writeln!(csv, "{CSV_HEADER}")?;
+        let has_observer = net
+            .agents
+            .first()
+            .is_some_and(|a| a.model.scheme.has_observer());
+        let series = net
+            .agents
+            .iter()
+            .map(|a| Series {
+                id: a.model.id,
+                ..Series::default()
+            })
+            .collect();
+        Ok(Self {
+            csv,
+            dt: net.dt,
+            has_observer,
+            series,
+        })
+    }
+
+    /// Writes one row per agent for `snap`. Errors are printed with Rust's
+    /// shortest round-trip formatting (full f64 precision).
+    pub fn record(&mut self, snap: &Snapshot<'_>) -> io::Result<()> {
+        let t_str = fmt_time(snap.step, self.dt);
+        let t: f64 = t_str.parse().expect("fmt_time prints a number");
+        for (x, s) in snap.agents.iter().zip(&mut self.series) {
+            let e = errors(x, snap.leader, self.has_observer);
+            s.t.push(t);
+            s.att.push(e.att);
+            s.angvel.push(e.angvel);
+            match e.observer {
+                Some((oa, ow)) => {
+                    s.obs_att.push(oa);
+                    s.obs_angvel.push(ow);
+                    writeln!(self.csv, "{t_str},{},{},{},{oa},{ow}", s.id, e.att, e.angvel)?;
+                }
+                None => writeln!(self.csv, "{t_str},{},{},{},,", s.id, e.att, e.angvel)?,
+            }
+        }
+        Ok(())
+    }
+
+    /// Flushes the CSV and returns the series.
+    pub fn finish(mut self) -> io::Result<Vec<Series>> {
+        self.csv.flush()?;
+        Ok(self.series)
+    }
+}
+
+/// Per-agent summaries from the series and peak torques (same order).
+#[must_use]
+pub fn agent_summaries(series: &[Series], peak_torques: &[f64]) -> Vec<AgentSummary> {
+    series
+        .iter()
+        .zip(peak_torques)
+        .map(|(s, &peak_torque)| AgentSummary {
+            id: s.id,
+            final_att_err: s.att.last().copied().unwrap_or(f64::NAN),
+            final_angvel_err: s.angvel.last().copied().unwrap_or(f64::NAN),
+            final_obs_att_err: s.obs_att.last().copied(),
+            final_obs_angvel_err: s.obs_angvel.last().copied(),
+            settle_time_1e3: summary::settle_time(&s.t, &s.att, 1e-3),
+            settle_time_1e6: summary::settle_time(&s.t, &s.att, 1e-6),
+            peak_torque,
+        })
+        .collect()
+}
+
+/// Writes `summary.json`.
+pub fn write_summary(dir: &Path, summary: &Summary) -> io::Result<()> {
+    let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
+    std::fs::write(dir.join(staging::MARKER), text + "\n")
+}

@@ -1,0 +1,126 @@
+//! `summary.json` and the table printed at the end of a run.
+
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+
+/// Per-agent results.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AgentSummary {
+    /// Agent id.
+    pub id: u32,
+    /// `|Rᵢ R₀ᵀ|_I` at the last sample.
+    pub final_att_err: f64,
+    /// `‖ωᵢ − ω₀‖` at the last sample, rad/s.
+    pub final_angvel_err: f64,
+    /// Observer attitude error at the last sample (schemes 1–2).
+    pub final_obs_att_err: Option<f64>,
+    /// Observer angular-velocity error at the last sample (schemes 1–2).
+    pub final_obs_angvel_err: Option<f64>,
+    /// Time after which `att_err` stays below 1e-3 (null: not by the end).
+    #[serde(rename = "settle_time_1e-3")]
+    pub settle_time_1e3: Option<f64>,
+    /// Time after which `att_err` stays below 1e-6 (null: not by the end).
+    #[serde(rename = "settle_time_1e-6")]
+    pub settle_time_1e6: Option<f64>,
+    /// Largest `‖τᵢ‖` applied at the start of any step, N·m.
+    pub peak_torque: f64,
+}
+
+/// The whole run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// attsync version that produced it.
+    pub attsync_version: String,
+    /// Scenario name.
+    pub scenario: String,
+    /// Engine used.
+    pub engine: String,
+    /// Whether the run reached its horizon.
+    pub complete: bool,
+    /// Why not, if not.
+    pub incomplete_reason: Option<String>,
+    /// Integrator step, s.
+    pub dt: f64,
+    /// Requested horizon, s.
+    pub duration: f64,
+    /// Simulated time reached, s.
+    pub t_end: f64,
+    /// Steps done.
+    pub steps: u64,
+    /// Wall-clock time of the simulation, s (not deterministic).
+    pub wall_seconds: f64,
+    /// Largest final `att_err` over agents.
+    pub max_final_att_err: f64,
+    /// Per agent, ascending id.
+    pub agents: Vec<AgentSummary>,
+}
+
+/// Time after which `err` stays below `threshold`: the sample after the last
+/// one at or above it; `Some(t[0])` if always below; `None` if the last
+/// sample is not below.
+#[must_use]
+pub fn settle_time(t: &[f64], err: &[f64], threshold: f64) -> Option<f64> {
+    match err.iter().rposition(|&e| e >= threshold || e.is_nan()) {
+        None => t.first().copied(),
+        Some(k) if k + 1 < t.len() => Some(t[k + 1]),
+        Some(_) => None,
+    }
+}
+
+impl Summary {
+    /// A fixed-width table of the per-agent results.
+    #[must_use]
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.3e}"));
+        let time = |x: Option<f64>| x.map_or("never".to_string(), |v| format!("{v:.2}"));
+        let _ = writeln!(
+            s,
+            "{:>5} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10}",
+            "agent", "att_err", "angvel_err", "obs_att", "obs_angvel", "t<1e-3", "t<1e-6", "peak_tau"
+        );
+        for a in &self.agents {
+            let _ = writeln!(
+                s,
+                "{:>5} {:>10.3e} {:>10.3e} {:>10} {:>10} {:>9} {:>9} {:>10.3e}",
+                a.id,
+                a.final_att_err,
+                a.final_angvel_err,
+                opt(a.final_obs_att_err),
+                opt(a.final_obs_angvel_err),
+                time(a.settle_time_1e3),
+                time(a.settle_time_1e6),
+                a.peak_torque
+            );
+        }
+        let _ = write!(
+            s,
+            "{} run of {}: t = {} s of {} s ({} steps, {:.2} s wall){}",
+            self.engine,
+            self.scenario,
+            self.t_end,
+            self.duration,
+            self.steps,
+            self.wall_seconds,
+            if self.complete {
+                String::new()
+            } else {
+                format!(" INCOMPLETE: {}", self.incomplete_reason.as_deref().unwrap_or("?"))
+            }
+        );
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::settle_time;
+
+    #[test]
+    fn settle_time_is_the_sample_after_the_last_excursion() {
+        let t = [0.0, 1.0, 2.0, 3.0];
+        assert_eq!(settle_time(&t, &[1.0, 1e-4, 2e-3, 1e-4], 1e-3), Some(3.0));
+        assert_eq!(settle_time(&t, &[1e-4; 4], 1e-3), Some(0.0));
+        assert_eq!(settle_time(&t, &[1e-4, 1e-4, 1e-4, 1.0], 1e-3), None);
+    }
+}

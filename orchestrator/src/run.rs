@@ -1,0 +1,149 @@
+//! `attsync run`: a loaded scenario through an engine into a results
+//! directory.
+
+use crate::results::{self, Recorder, Summary, plot, staging::Staging};
+use crate::scenario::Loaded;
+use attitude::engine::InProcess;
+use indicatif::{ProgressBar, ProgressState, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+use thiserror::Error;
+
+/// Which engine runs the network.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Engine {
+    /// Every node in the orchestrator's process, in lockstep.
+    InProcess,
+}
+
+impl Engine {
+    /// Name as written on the command line and in `summary.json`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::InProcess => "in-process",
+        }
+    }
+}
+
+/// Options of one run.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Engine.
+    pub engine: Engine,
+    /// Results directory.
+    pub out: PathBuf,
+    /// Draw a progress bar on stderr (it also hides itself when stderr is not a terminal).
+    pub progress: bool,
+}
+
+/// Why a run produced no results.
+#[derive(Debug, Error)]
+pub enum RunError {
+    /// Writing results failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// File or directory concerned.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Drawing the plot failed.
+    #[error("{path}: cannot draw plot: {message}")]
+    Plot {
+        /// The plot file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
+    move |source| RunError::Io {
+        path: path.to_owned(),
+        source,
+    }
+}
+
+/// Runs `loaded` and writes its results to `opts.out` (atomically). Stops
+/// early, keeping the results so far marked incomplete, when `interrupt`
+/// becomes true.
+pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &AtomicBool) -> Result<Summary, RunError> {
+    let net = &loaded.resolved.network;
+    let staging = Staging::new(&opts.out).map_err(io_at(&opts.out))?;
+    let dir = staging.path().to_owned();
+    let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
+    std::fs::write(dir.join("scenario.toml"), text).map_err(io_at(&dir))?;
+    let mut recorder = Recorder::new(&dir, net).map_err(io_at(&dir))?;
+
+    let bar = progress_bar(opts.progress, net.steps, net.dt);
+    let started = Instant::now();
+    let mut engine = InProcess::new(net);
+    let mut write_error = None;
+    let mut interrupted = false;
+    engine.run(|snap| {
+        if let Err(e) = recorder.record(snap) {
+            write_error = Some(e);
+            return false;
+        }
+        bar.set_position(snap.step);
+        if interrupt.load(Ordering::Relaxed) {
+            interrupted = true;
+            return false;
+        }
+        true
+    });
+    let wall_seconds = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    if let Some(e) = write_error {
+        return Err(io_at(&dir)(e));
+    }
+    let series = recorder.finish().map_err(io_at(&dir))?;
+    let peaks: Vec<f64> = engine.agents().iter().map(|a| a.peak_torque()).collect();
+    let agents = results::agent_summaries(&series, &peaks);
+    let steps = engine.step_index();
+    let summary = Summary {
+        attsync_version: env!("CARGO_PKG_VERSION").into(),
+        scenario: loaded.name(),
+        engine: opts.engine.name().into(),
+        complete: !interrupted && steps == net.steps,
+        incomplete_reason: interrupted.then(|| "interrupted".to_string()),
+        dt: net.dt,
+        duration: net.steps as f64 * net.dt,
+        t_end: steps as f64 * net.dt,
+        steps,
+        wall_seconds,
+        max_final_att_err: agents.iter().map(|a| a.final_att_err).fold(0.0, f64::max),
+        agents,
+    };
+    let svg = dir.join("errors.svg");
+    plot::draw(&svg, &format!("{} ({})", summary.scenario, summary.engine), &series).map_err(
+        |message| RunError::Plot {
+            path: svg.clone(),
+            message,
+        },
+    )?;
+    // summary.json last: it marks the directory as complete results.
+    results::write_summary(&dir, &summary).map_err(io_at(&dir))?;
+    staging.commit().map_err(io_at(&opts.out))?;
+    Ok(summary)
+}
+
+fn progress_bar(enabled: bool, steps: u64, dt: f64) -> ProgressBar {
+    if !enabled {
+        return ProgressBar::hidden();
+    }
+    let total = steps as f64 * dt;
+    let style = ProgressStyle::with_template(&format!(
+        "{{bar:40}} t = {{simt}} / {total} s  {{rtf}}× real time  eta {{eta}}"
+    ))
+    .expect("valid template")
+    .with_key("simt", move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
+        let _ = write!(w, "{:.2}", s.pos() as f64 * dt);
+    })
+    .with_key("rtf", move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
+        let _ = write!(w, "{:.1}", s.per_sec() * dt);
+    });
+    ProgressBar::new(steps).with_style(style)
+}

@@ -1,0 +1,51 @@
+//! The text `attsync check` prints.
+
+use super::Loaded;
+use super::resolve::kind_name;
+use attitude::network::Coupling;
+use std::fmt::Write as _;
+
+/// A human-readable description of a validated scenario.
+#[must_use]
+pub fn describe(l: &Loaded) -> String {
+    let r = &l.resolved;
+    let n = &r.network;
+    let mut s = String::new();
+    let _ = writeln!(s, "{}: OK", l.file.display());
+    let _ = writeln!(s, "name:      {}", l.name());
+    let _ = writeln!(s, "scheme:    {}", kind_name(l.scenario.scheme.kind));
+    let coupling = match n.coupling {
+        Coupling::Continuous => "continuous (exchange at every stage)".to_string(),
+        Coupling::Sampled { every } => format!("sampled every {every} steps ({} s)", every as f64 * n.dt),
+    };
+    let _ = writeln!(s, "time:      dt = {} s, {} steps, duration {} s, coupling {coupling}", n.dt, n.steps, n.steps as f64 * n.dt);
+    let _ = writeln!(s, "agents:    {}", n.agents.len());
+    for a in &n.agents {
+        let nb: Vec<String> = a.model.neighbours.iter().map(|x| x.id.to_string()).collect();
+        let _ = writeln!(
+            s,
+            "  agent {:>3}  J diag {:?}  neighbours [{}]{}",
+            a.model.id,
+            [a.model.inertia.j[(0, 0)], a.model.inertia.j[(1, 1)], a.model.inertia.j[(2, 2)]],
+            nb.join(", "),
+            if a.model.leader_gain.is_some() { "  + leader" } else { "" }
+        );
+    }
+    let edges: Vec<String> = r.edges.iter().map(|(a, b)| format!("{a}–{b}")).collect();
+    let _ = writeln!(s, "edges:     {}", edges.join(", "));
+    let links: Vec<String> = r.leader_links.iter().map(|a| format!("0→{a}")).collect();
+    let _ = writeln!(s, "leader:    {}", links.join(", "));
+    let spec: Vec<String> = r.spectrum.iter().map(|e| format!("{e:.6}")).collect();
+    let _ = writeln!(s, "spectrum of Ξ + LLᵀ: [{}]", spec.join(", "));
+    if let Some(m) = r.appendix_d_min_eig {
+        let _ = writeln!(
+            s,
+            "gain condition (Appendix D, F > 0): {} (λmin(F) = {m:.6e})",
+            if m > 0.0 { "holds" } else { "FAILS" }
+        );
+    }
+    for w in &r.warnings {
+        let _ = writeln!(s, "warning: {w}");
+    }
+    s
+}

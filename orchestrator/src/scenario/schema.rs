@@ -1,0 +1,247 @@
+//! The scenario file format (TOML), as serde types. Unknown keys are
+//! rejected everywhere. See README.md § Scenario format.
+
+use serde::{Deserialize, Serialize};
+
+/// A whole scenario file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name, used in outputs.
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Free text.
+    #[serde(default)]
+    pub description: Option<String>,
+    /// Time step, horizon and exchange schedule.
+    pub simulation: Simulation,
+    /// Output sampling.
+    #[serde(default)]
+    pub output: Output,
+    /// The control scheme and its scalar gains.
+    pub scheme: SchemeSpec,
+    /// The virtual leader 0.
+    pub leader: LeaderSpec,
+    /// Agents that hear the leader, with their gains `A_{i,0}`.
+    #[serde(default, rename = "leader_link")]
+    pub leader_links: Vec<LeaderLinkSpec>,
+    /// The followers.
+    #[serde(default, rename = "agent")]
+    pub agents: Vec<AgentSpec>,
+    /// Undirected follower edges with their gains `A_{i,j}`.
+    #[serde(default, rename = "edge")]
+    pub edges: Vec<EdgeSpec>,
+}
+
+/// `[simulation]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Simulation {
+    /// Integrator step, s.
+    pub dt: f64,
+    /// Simulated horizon, s (a multiple of `dt`).
+    pub duration: f64,
+    /// Exchange semantics.
+    #[serde(default)]
+    pub coupling: CouplingKind,
+    /// Exchange period for `coupling = "sampled"`, s (a multiple of `dt`).
+    #[serde(default)]
+    pub period: Option<f64>,
+}
+
+/// `simulation.coupling`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CouplingKind {
+    /// Exchange at every integrator stage (the continuous-time closed loop).
+    #[default]
+    Continuous,
+    /// Exchange once per `period`, hold in between.
+    Sampled,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    /// Period of the rows of `errors.csv`, s (a multiple of `dt`).
+    #[serde(default = "default_sample_period")]
+    pub sample_period: f64,
+}
+
+fn default_sample_period() -> f64 {
+    0.01
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Self {
+            sample_period: default_sample_period(),
+        }
+    }
+}
+
+/// `[scheme]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SchemeSpec {
+    /// Which of the paper's schemes.
+    pub kind: SchemeKind,
+    /// Observer gains (schemes 1 and 2).
+    #[serde(default)]
+    pub observer: Option<ObserverGainsSpec>,
+    /// Control gains.
+    pub control: ControlGainsSpec,
+}
+
+/// `scheme.kind`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SchemeKind {
+    /// Scheme 1: observer `7a`–`7c` + law `control` (time-varying reference).
+    ObserverTimeVarying,
+    /// Scheme 2: observer `16a`–`16b` + law `controlconstantestimate`.
+    ObserverConstant,
+    /// Scheme 3: law `districontrol`, no observer.
+    Observerless,
+}
+
+/// `scheme.observer`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObserverGainsSpec {
+    /// `k_R` of the observer.
+    pub k_r: f64,
+    /// `k_ω` of the observer.
+    pub k_omega: f64,
+    /// `k_σ` (scheme 1 only).
+    #[serde(default)]
+    pub k_sigma: Option<f64>,
+}
+
+/// `scheme.control`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlGainsSpec {
+    /// `k_R̄` (schemes 1–2) or `k_Ř` (scheme 3).
+    pub k_r: f64,
+    /// `k_ω̄` (schemes 1–2) or `k_ω̌` (scheme 3).
+    pub k_omega: f64,
+}
+
+/// `[leader]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LeaderSpec {
+    /// Time-varying (eq. `leader`) or constant.
+    pub reference: ReferenceKind,
+    /// Generator `P` of `σ̇₀ = P σ₀` (3 rows of 3), required by scheme 1.
+    #[serde(default)]
+    pub p: Option<[[f64; 3]; 3]>,
+    /// `R₀(0)`.
+    pub attitude: RotationSpec,
+    /// `ω₀(0)`, rad/s (time-varying only).
+    #[serde(default)]
+    pub omega: Option<[f64; 3]>,
+    /// `σ₀(0)`, rad/s² (time-varying only).
+    #[serde(default)]
+    pub sigma: Option<[f64; 3]>,
+}
+
+/// `leader.reference`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ReferenceKind {
+    /// `Ṙ₀ = R₀ω₀^×, ω̇₀ = σ₀, σ̇₀ = Pσ₀`.
+    TimeVarying,
+    /// `R₀` constant.
+    Constant,
+}
+
+/// `[[leader_link]]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LeaderLinkSpec {
+    /// The agent that hears the leader.
+    pub agent: u32,
+    /// `A_{i,0}` (or `Ǎ_{i,0}`): 3 numbers (diagonal) or 3 rows of 3.
+    pub gain: MatrixSpec,
+}
+
+/// `[[agent]]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AgentSpec {
+    /// Agent id, ≥ 1 (0 is the leader).
+    pub id: u32,
+    /// Inertia `Jᵢ`, kg·m²: 3 numbers (diagonal) or 3 rows of 3.
+    pub inertia: MatrixSpec,
+    /// `Rᵢ(0)`.
+    pub attitude: RotationSpec,
+    /// `ωᵢ(0)`, body frame, rad/s.
+    pub omega: [f64; 3],
+    /// `Āᵢ` of the control law (schemes 1–2).
+    #[serde(default)]
+    pub control_gain: Option<MatrixSpec>,
+    /// The observer's initial state (schemes 1–2).
+    #[serde(default)]
+    pub observer: Option<ObserverInit>,
+}
+
+/// `agent.observer`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObserverInit {
+    /// `R̂ᵢ(0)`.
+    pub attitude: RotationSpec,
+    /// `ω̂ᵢ(0)`, rad/s.
+    pub omega: [f64; 3],
+    /// `σ̂ᵢ(0)`, rad/s² (scheme 1).
+    #[serde(default)]
+    pub sigma: Option<[f64; 3]>,
+}
+
+/// `[[edge]]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EdgeSpec {
+    /// The two agent ids.
+    pub agents: [u32; 2],
+    /// `A_{i,j} = A_{j,i}` (or `Ǎ_{i,j}`): 3 numbers (diagonal) or 3 rows of 3.
+    pub gain: MatrixSpec,
+}
+
+/// A 3×3 matrix: its diagonal or its rows.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(untagged, expecting = "3 numbers (a diagonal) or 3 rows of 3 numbers")]
+pub enum MatrixSpec {
+    /// `diag(a, b, c)`.
+    Diagonal([f64; 3]),
+    /// Rows.
+    Rows([[f64; 3]; 3]),
+}
+
+/// A rotation: exactly one of axis + angle (in rad, deg or multiples of π),
+/// a unit quaternion `[w, x, y, z]`, or a rotation matrix (rows).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RotationSpec {
+    /// Rotation axis (normalised on use).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[f64; 3]>,
+    /// Angle in radians.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_rad: Option<f64>,
+    /// Angle in degrees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<f64>,
+    /// Angle in multiples of π (`angle_pi = 0.1` is π/10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_pi: Option<f64>,
+    /// Unit quaternion, scalar first `[w, x, y, z]` (normalised on use).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quaternion: Option<[f64; 4]>,
+    /// Rotation matrix, rows (must be orthogonal with det +1 to 1e-9).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matrix: Option<[[f64; 3]; 3]>,
+}
