@@ -12,7 +12,9 @@
 //! values, an agent computes bit-identical results in any process.
 
 use crate::body::omega_dot;
-use crate::control::{tau_control, tau_control_constant_estimate, tau_districontrol, tracking_error};
+use crate::control::{
+    tau_control, tau_control_constant_estimate, tau_districontrol, tracking_error,
+};
 use crate::integrate::{LieDerivative, LieState, Rkmk4};
 use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
 use crate::observer::{

@@ -48,12 +48,7 @@ fn forced(t: f64, y: &Body) -> LieDerivative<1, 1> {
 }
 
 /// `n` steps of size `h` from t = 0.
-fn integrate(
-    f: impl Fn(f64, &Body) -> LieDerivative<1, 1>,
-    y0: &Body,
-    h: f64,
-    n: usize,
-) -> Body {
+fn integrate(f: impl Fn(f64, &Body) -> LieDerivative<1, 1>, y0: &Body, h: f64, n: usize) -> Body {
     let mut y = *y0;
     for k in 0..n {
         y = rkmk4_step(&y, k as f64 * h, h, &f);
@@ -79,7 +74,11 @@ fn assert_fourth_order(name: &str, f: impl Fn(f64, &Body) -> LieDerivative<1, 1>
         let e = errors_at_t2(f, h);
         for k in 0..2 {
             let ratio = e[k] / e[k + 1];
-            eprintln!("{name}: h = {:.4}: error {:.3e}, ratio {ratio:.2}", h / (1 << k) as f64, e[k]);
+            eprintln!(
+                "{name}: h = {:.4}: error {:.3e}, ratio {ratio:.2}",
+                h / (1 << k) as f64,
+                e[k]
+            );
             assert!(
                 (12.0..=20.0).contains(&ratio),
                 "{name}: error({})/error({}) = {ratio} (errors {e:?}), expected ≈ 16",
@@ -143,13 +142,13 @@ fn vector_part_is_classical_rk4() {
     let h = 0.25;
     let y = rkmk4_step(&LieState { rot: [], vec: [x0] }, 0.0, h, f);
     let hm = m * h;
-    let taylor = Matrix3::identity()
-        + hm
-        + hm * hm / 2.0
-        + hm * hm * hm / 6.0
-        + hm * hm * hm * hm / 24.0;
+    let taylor =
+        Matrix3::identity() + hm + hm * hm / 2.0 + hm * hm * hm / 6.0 + hm * hm * hm * hm / 24.0;
     let d = (y.vec[0] - taylor * x0).norm();
-    assert!(d < 1e-15 * x0.norm(), "RK4 on ẋ = Mx differs from its Taylor polynomial by {d:e}");
+    assert!(
+        d < 1e-15 * x0.norm(),
+        "RK4 on ẋ = Mx differs from its Taylor polynomial by {d:e}"
+    );
 }
 
 #[test]
@@ -170,7 +169,11 @@ fn stage_wise_api_is_bit_identical_to_rkmk4_step() {
             }
             let k = forced(t + [0.0, 0.5, 0.5, 1.0][s] * h, &step.stage_state());
             done = step.push_derivative(&k);
-            assert_eq!(done.is_some(), s == 3, "step completes after the fourth stage only");
+            assert_eq!(
+                done.is_some(),
+                s == 3,
+                "step completes after the fourth stage only"
+            );
         }
         b = done.expect("fourth stage completes the step");
         assert_eq!(a, b, "step {n}");
@@ -187,7 +190,10 @@ fn rkmk4_step_evaluates_at_the_stage_times() {
         torque_free(ts, y)
     });
     assert_eq!(*times.borrow(), vec![t, t + 0.5 * h, t + 0.5 * h, t + h]);
-    assert_eq!((0..4).map(stage_time_fraction).collect::<Vec<_>>(), vec![0.0, 0.5, 0.5, 1.0]);
+    assert_eq!(
+        (0..4).map(stage_time_fraction).collect::<Vec<_>>(),
+        vec![0.0, 0.5, 0.5, 1.0]
+    );
 }
 
 #[test]

@@ -123,7 +123,10 @@ fn controlerror1_holds_with_the_corrected_sigma_and_gamma() {
         let tau = torque(t);
         let scale = lhs.norm().max(sw.norm()).max(g.norm()).max(tau.norm());
         let residual = lhs - (sw + g + tau);
-        eprintln!("t = {t}: |J dω̄/dt − (Σω̄ + Γ + τ)| = {:.2e} (scale {scale:.2})", residual.norm());
+        eprintln!(
+            "t = {t}: |J dω̄/dt − (Σω̄ + Γ + τ)| = {:.2e} (scale {scale:.2})",
+            residual.norm()
+        );
         assert!(
             residual.norm() < 1e-8 * scale,
             "t = {t}: residual {residual:?}, scale {scale}"
@@ -152,7 +155,10 @@ fn printed_sigma_and_gamma_leave_minus_two_omega_cross_jv() {
             (residual - predicted).norm()
         );
         // The printed law is off by a margin that no discretisation explains...
-        assert!(residual.norm() > 0.1, "t = {t}: printed residual only {residual:?}");
+        assert!(
+            residual.norm() > 0.1,
+            "t = {t}: printed residual only {residual:?}"
+        );
         // ...and the defect is exactly −2 ω × J v.
         assert!(
             (residual - predicted).norm() < 1e-8 * (1.0 + predicted.norm()),
@@ -180,7 +186,10 @@ fn r_bar_follows_r_bar_times_omega_bar_hat() {
 #[test]
 fn corrected_law_gives_controlerror2() {
     let j = inertia();
-    let g = ControlGains { k_r: 8.0, k_w: 13.0 };
+    let g = ControlGains {
+        k_r: 8.0,
+        k_w: 13.0,
+    };
     let a_bar = Matrix3::from_diagonal(&Vector3::new(11.0, 12.0, 13.0));
     let ys = trajectory(CHECK_AT[3] + 2 * STRIDE, |t, y| {
         tau_control(&g, &j, &a_bar, &error_of(t, y), &w_hat_dot(t))

@@ -83,7 +83,10 @@ fn the_conservation_bound_catches_a_wrong_sign_or_a_low_order_step() {
     };
     let (dpi, de) = drifts(1e-3, 100_000, flipped);
     eprintln!("flipped gyroscopic sign: momentum drift {dpi:.2e}, energy drift {de:.2e}");
-    assert!(dpi > 1e-2, "a wrong gyroscopic sign should not conserve RJω ({dpi:e})");
+    assert!(
+        dpi > 1e-2,
+        "a wrong gyroscopic sign should not conserve RJω ({dpi:e})"
+    );
 
     let lie_euler = |y: &Body, t: f64, h: f64| {
         let k = torque_free(t, y);
@@ -94,7 +97,10 @@ fn the_conservation_bound_catches_a_wrong_sign_or_a_low_order_step() {
     };
     let (dpi, de) = drifts(1e-3, 100_000, lie_euler);
     eprintln!("Lie–Euler: momentum drift {dpi:.2e}, energy drift {de:.2e}");
-    assert!(dpi > 1e-6 && de > 1e-6, "a first-order step should drift ({dpi:e}, {de:e})");
+    assert!(
+        dpi > 1e-6 && de > 1e-6,
+        "a first-order step should drift ({dpi:e}, {de:e})"
+    );
 }
 
 /// Consistency: the energy error up to T = 20 falls like h⁴ when h is halved

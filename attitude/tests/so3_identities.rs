@@ -63,9 +63,8 @@ fn rotation() -> impl Strategy<Value = Matrix3<f64>> {
 
 /// `Q diag(λ) Qᵀ` with eigenvalues in [0.5, 20]: symmetric positive definite.
 fn spd() -> impl Strategy<Value = Matrix3<f64>> {
-    (rotation(), prop::array::uniform3(0.5..20.0)).prop_map(|(q, l)| {
-        q * Matrix3::from_diagonal(&Vector3::from(l)) * q.transpose()
-    })
+    (rotation(), prop::array::uniform3(0.5..20.0))
+        .prop_map(|(q, l)| q * Matrix3::from_diagonal(&Vector3::from(l)) * q.transpose())
 }
 
 /// Five-point central difference of a matrix-valued function at 0.
@@ -348,17 +347,34 @@ fn tree() -> impl Strategy<Value = Tree> {
         .prop_map(|(r0, r, gains, flip)| {
             let mut edges: Vec<Edge> = LEADER_LINKS
                 .iter()
-                .map(|&i| Edge { a: i, b: None, gain: 0 })
+                .map(|&i| Edge {
+                    a: i,
+                    b: None,
+                    gain: 0,
+                })
                 .collect();
             for (&(i, j), f) in FOLLOWER_EDGES.iter().zip(flip) {
                 let (a, b) = if f { (j, i) } else { (i, j) };
-                edges.push(Edge { a, b: Some(b), gain: 0 });
+                edges.push(Edge {
+                    a,
+                    b: Some(b),
+                    gain: 0,
+                });
             }
             for (k, e) in edges.iter_mut().enumerate() {
                 e.gain = k;
             }
-            assert_eq!(edges.len(), N, "a spanning tree of the augmented graph has N edges");
-            Tree { r0, r, gains, edges }
+            assert_eq!(
+                edges.len(),
+                N,
+                "a spanning tree of the augmented graph has N edges"
+            );
+            Tree {
+                r0,
+                r,
+                gains,
+                edges,
+            }
         })
 }
 
@@ -407,7 +423,10 @@ fn lemma_le3_fails_with_the_ends_swapped() {
     let worst = (0..N)
         .map(|i| (t.lhs_left(i) - t.rhs_left(i, true)).norm())
         .fold(0.0, f64::max);
-    assert!(worst > 1.0, "swapped blocks should break le3, residual {worst}");
+    assert!(
+        worst > 1.0,
+        "swapped blocks should break le3, residual {worst}"
+    );
     for i in 0..N {
         assert_relative_eq!(t.lhs_left(i), t.rhs_left(i, false), epsilon = 1e-12);
     }
@@ -472,6 +491,9 @@ fn dexp_inv_correction_is_resolved() {
     let d = 1e-3 / ud.norm();
     let fd = d5(|t| exp(&(u + ud * t)), d);
     let e = (fd - exp(&u) * hat(&w)).amax();
-    assert!(e > 2e-11 * (1.0 + w.norm()), "defect without the c-term {e:e}");
+    assert!(
+        e > 2e-11 * (1.0 + w.norm()),
+        "defect without the c-term {e:e}"
+    );
     assert!(dexp_inv_defect(&u, &w) < 2e-11 * (1.0 + w.norm()));
 }

@@ -94,13 +94,24 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
         SchemeKind::ObserverTimeVarying => (
             SchemeSpec {
                 kind: p.scheme,
-                observer: Some(ObserverGainsSpec { k_r: 9.0, k_omega: 14.0, k_sigma: Some(12.0) }),
-                control: ControlGainsSpec { k_r: 8.0, k_omega: 13.0 },
+                observer: Some(ObserverGainsSpec {
+                    k_r: 9.0,
+                    k_omega: 14.0,
+                    k_sigma: Some(12.0),
+                }),
+                control: ControlGainsSpec {
+                    k_r: 8.0,
+                    k_omega: 13.0,
+                },
             },
             LeaderSpec {
                 reference: ReferenceKind::TimeVarying,
                 p: Some(PAPER_P),
-                attitude: RotationSpec { axis: Some([1.0, 4.0, 2.0]), angle_pi: Some(0.8), ..Default::default() },
+                attitude: RotationSpec {
+                    axis: Some([1.0, 4.0, 2.0]),
+                    angle_pi: Some(0.8),
+                    ..Default::default()
+                },
                 omega: Some([1.0, 2.0, 0.0]),
                 sigma: Some([0.2, 1.0, 0.0]),
             },
@@ -108,8 +119,15 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
         SchemeKind::ObserverConstant => (
             SchemeSpec {
                 kind: p.scheme,
-                observer: Some(ObserverGainsSpec { k_r: 14.0, k_omega: 12.0, k_sigma: None }),
-                control: ControlGainsSpec { k_r: 13.0, k_omega: 11.0 },
+                observer: Some(ObserverGainsSpec {
+                    k_r: 14.0,
+                    k_omega: 12.0,
+                    k_sigma: None,
+                }),
+                control: ControlGainsSpec {
+                    k_r: 13.0,
+                    k_omega: 11.0,
+                },
             },
             constant_leader(),
         ),
@@ -117,18 +135,29 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
             SchemeSpec {
                 kind: p.scheme,
                 observer: None,
-                control: ControlGainsSpec { k_r: 1.9, k_omega: 1.9 },
+                control: ControlGainsSpec {
+                    k_r: 1.9,
+                    k_omega: 1.9,
+                },
             },
             constant_leader(),
         ),
     };
     Ok(Scenario {
-        name: Some(format!("tree-{}-{}-seed{}", p.agents, p.leader_links, p.seed)),
+        name: Some(format!(
+            "tree-{}-{}-seed{}",
+            p.agents, p.leader_links, p.seed
+        )),
         description: Some(format!(
             "Random tree: {} agents, {} leader links, seed {} (attsync gen tree).",
             p.agents, p.leader_links, p.seed
         )),
-        simulation: Simulation { dt: 0.001, duration: p.duration, coupling: CouplingKind::Continuous, period: None },
+        simulation: Simulation {
+            dt: 0.001,
+            duration: p.duration,
+            coupling: CouplingKind::Continuous,
+            period: None,
+        },
         output: Output::default(),
         scheme,
         leader,
@@ -142,14 +171,22 @@ fn constant_leader() -> LeaderSpec {
     LeaderSpec {
         reference: ReferenceKind::Constant,
         p: None,
-        attitude: RotationSpec { axis: Some([1.0, 4.0, 2.0]), angle_pi: Some(0.8), ..Default::default() },
+        attitude: RotationSpec {
+            axis: Some([1.0, 4.0, 2.0]),
+            angle_pi: Some(0.8),
+            ..Default::default()
+        },
         omega: None,
         sigma: None,
     }
 }
 
 fn random_vec(rng: &mut ChaCha8Rng, a: f64) -> [f64; 3] {
-    [rng.random_range(-a..a), rng.random_range(-a..a), rng.random_range(-a..a)]
+    [
+        rng.random_range(-a..a),
+        rng.random_range(-a..a),
+        rng.random_range(-a..a),
+    ]
 }
 
 fn random_rotation(rng: &mut ChaCha8Rng) -> RotationSpec {

@@ -69,7 +69,11 @@ fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 /// Runs `loaded` and writes its results to `opts.out` (atomically). Stops
 /// early, keeping the results so far marked incomplete, when `interrupt`
 /// becomes true.
-pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &AtomicBool) -> Result<Summary, RunError> {
+pub fn run(
+    loaded: &Loaded,
+    opts: &RunOptions,
+    interrupt: &AtomicBool,
+) -> Result<Summary, RunError> {
     let net = &loaded.resolved.network;
     let staging = Staging::new(&opts.out).map_err(io_at(&opts.out))?;
     let dir = staging.path().to_owned();
@@ -118,12 +122,15 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &AtomicBool) -> Result
         agents,
     };
     let svg = dir.join("errors.svg");
-    plot::draw(&svg, &format!("{} ({})", summary.scenario, summary.engine), &series).map_err(
-        |message| RunError::Plot {
-            path: svg.clone(),
-            message,
-        },
-    )?;
+    plot::draw(
+        &svg,
+        &format!("{} ({})", summary.scenario, summary.engine),
+        &series,
+    )
+    .map_err(|message| RunError::Plot {
+        path: svg.clone(),
+        message,
+    })?;
     // summary.json last: it marks the directory as complete results.
     results::write_summary(&dir, &summary).map_err(io_at(&dir))?;
     staging.commit().map_err(io_at(&opts.out))?;
@@ -139,11 +146,17 @@ fn progress_bar(enabled: bool, steps: u64, dt: f64) -> ProgressBar {
         "{{bar:40}} t = {{simt}} / {total} s  {{rtf}}× real time  eta {{eta}}"
     ))
     .expect("valid template")
-    .with_key("simt", move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
-        let _ = write!(w, "{:.2}", s.pos() as f64 * dt);
-    })
-    .with_key("rtf", move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
-        let _ = write!(w, "{:.1}", s.per_sec() * dt);
-    });
+    .with_key(
+        "simt",
+        move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = write!(w, "{:.2}", s.pos() as f64 * dt);
+        },
+    )
+    .with_key(
+        "rtf",
+        move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = write!(w, "{:.1}", s.per_sec() * dt);
+        },
+    );
     ProgressBar::new(steps).with_style(style)
 }

@@ -47,7 +47,11 @@ pub struct Recorder {
 pub fn fmt_time(step: u64, dt: f64) -> String {
     let s = format!("{:.9}", step as f64 * dt);
     let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s.is_empty() { "0".into() } else { s.to_string() }
+    if s.is_empty() {
+        "0".into()
+    } else {
+        s.to_string()
+    }
 }
 
 impl Recorder {
@@ -89,7 +93,11 @@ impl Recorder {
                 Some((oa, ow)) => {
                     s.obs_att.push(oa);
                     s.obs_angvel.push(ow);
-                    writeln!(self.csv, "{t_str},{},{},{},{oa},{ow}", s.id, e.att, e.angvel)?;
+                    writeln!(
+                        self.csv,
+                        "{t_str},{},{},{},{oa},{ow}",
+                        s.id, e.att, e.angvel
+                    )?;
                 }
                 None => writeln!(self.csv, "{t_str},{},{},{},,", s.id, e.att, e.angvel)?,
             }

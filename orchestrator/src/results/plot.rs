@@ -17,9 +17,12 @@ pub fn draw(file: &Path, title: &str, series: &[Series]) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let (top, bottom) = root.split_vertically(440);
     panel(&top, "attitude error |R_i R_0^T|_I", series, |s| &s.att)?;
-    panel(&bottom, "angular velocity error ||w_i - w_0|| (rad/s)", series, |s| {
-        &s.angvel
-    })?;
+    panel(
+        &bottom,
+        "angular velocity error ||w_i - w_0|| (rad/s)",
+        series,
+        |s| &s.angvel,
+    )?;
     root.present().map_err(|e| e.to_string())
 }
 
@@ -40,7 +43,11 @@ fn panel<DB: DrawingBackend>(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
             (lo.min(v.max(FLOOR)), hi.max(v.max(FLOOR)))
         });
-    let (lo, hi) = if lo.is_finite() { (lo / 2.0, hi * 2.0) } else { (FLOOR, 1.0) };
+    let (lo, hi) = if lo.is_finite() {
+        (lo / 2.0, hi * 2.0)
+    } else {
+        (FLOOR, 1.0)
+    };
     let mut chart = ChartBuilder::on(area)
         .margin(12)
         .x_label_area_size(40)
@@ -64,7 +71,9 @@ fn panel<DB: DrawingBackend>(
             ))
             .map_err(|e| e.to_string())?
             .label(format!("agent {}", s.id))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+            });
     }
     chart
         .configure_series_labels()

@@ -38,7 +38,10 @@ impl Staging {
             .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "output path has no name"))?
             .to_string_lossy()
             .into_owned();
-        let parent = dest.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        let parent = dest
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
         fs::create_dir_all(parent)?;
         let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
         if tmp.exists() {

@@ -77,7 +77,14 @@ impl Summary {
         let _ = writeln!(
             s,
             "{:>5} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10}",
-            "agent", "att_err", "angvel_err", "obs_att", "obs_angvel", "t<1e-3", "t<1e-6", "peak_tau"
+            "agent",
+            "att_err",
+            "angvel_err",
+            "obs_att",
+            "obs_angvel",
+            "t<1e-3",
+            "t<1e-6",
+            "peak_tau"
         );
         for a in &self.agents {
             let _ = writeln!(
@@ -105,7 +112,10 @@ impl Summary {
             if self.complete {
                 String::new()
             } else {
-                format!(" INCOMPLETE: {}", self.incomplete_reason.as_deref().unwrap_or("?"))
+                format!(
+                    " INCOMPLETE: {}",
+                    self.incomplete_reason.as_deref().unwrap_or("?")
+                )
             }
         );
         s

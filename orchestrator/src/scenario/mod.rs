@@ -99,7 +99,9 @@ pub fn load_str(file: &Path, text: &str, overrides: &[String]) -> Result<Loaded,
         file: file.to_owned(),
         message,
     };
-    let mut document: toml::Table = text.parse().map_err(|e: toml::de::Error| parse(e.to_string()))?;
+    let mut document: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| parse(e.to_string()))?;
     for o in overrides {
         overrides::apply(&mut document, o).map_err(|message| ScenarioError::Override {
             file: file.to_owned(),

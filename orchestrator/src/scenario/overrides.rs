@@ -15,7 +15,9 @@ pub fn apply(doc: &mut Table, spec: &str) -> Result<(), String> {
         .ok_or_else(|| format!("`{spec}`: expected key.path=value"))?;
     let value = parse_value(raw.trim());
     let segments = parse_path(path.trim())?;
-    let (last, parents) = segments.split_last().expect("parse_path returns ≥ 1 segment");
+    let (last, parents) = segments
+        .split_last()
+        .expect("parse_path returns ≥ 1 segment");
     let mut table = doc;
     for (key, index) in parents {
         let entry = table
@@ -99,7 +101,11 @@ mod tests {
         assert_eq!(t["simulation"]["duration"].as_integer(), Some(10));
         assert_eq!(t["agent"][1]["omega"][2].as_integer(), Some(1));
         assert_eq!(t["scheme"]["kind"].as_str(), Some("observerless"));
-        assert!(apply(&mut t, "agent[5].id=3").unwrap_err().contains("out of range"));
+        assert!(
+            apply(&mut t, "agent[5].id=3")
+                .unwrap_err()
+                .contains("out of range")
+        );
         assert!(apply(&mut t, "no_equals").is_err());
     }
 }

@@ -16,19 +16,40 @@ pub fn describe(l: &Loaded) -> String {
     let _ = writeln!(s, "scheme:    {}", kind_name(l.scenario.scheme.kind));
     let coupling = match n.coupling {
         Coupling::Continuous => "continuous (exchange at every stage)".to_string(),
-        Coupling::Sampled { every } => format!("sampled every {every} steps ({} s)", every as f64 * n.dt),
+        Coupling::Sampled { every } => {
+            format!("sampled every {every} steps ({} s)", every as f64 * n.dt)
+        }
     };
-    let _ = writeln!(s, "time:      dt = {} s, {} steps, duration {} s, coupling {coupling}", n.dt, n.steps, n.steps as f64 * n.dt);
+    let _ = writeln!(
+        s,
+        "time:      dt = {} s, {} steps, duration {} s, coupling {coupling}",
+        n.dt,
+        n.steps,
+        n.steps as f64 * n.dt
+    );
     let _ = writeln!(s, "agents:    {}", n.agents.len());
     for a in &n.agents {
-        let nb: Vec<String> = a.model.neighbours.iter().map(|x| x.id.to_string()).collect();
+        let nb: Vec<String> = a
+            .model
+            .neighbours
+            .iter()
+            .map(|x| x.id.to_string())
+            .collect();
         let _ = writeln!(
             s,
             "  agent {:>3}  J diag {:?}  neighbours [{}]{}",
             a.model.id,
-            [a.model.inertia.j[(0, 0)], a.model.inertia.j[(1, 1)], a.model.inertia.j[(2, 2)]],
+            [
+                a.model.inertia.j[(0, 0)],
+                a.model.inertia.j[(1, 1)],
+                a.model.inertia.j[(2, 2)]
+            ],
             nb.join(", "),
-            if a.model.leader_gain.is_some() { "  + leader" } else { "" }
+            if a.model.leader_gain.is_some() {
+                "  + leader"
+            } else {
+                ""
+            }
         );
     }
     let edges: Vec<String> = r.edges.iter().map(|(a, b)| format!("{a}–{b}")).collect();

@@ -2,13 +2,11 @@
 //! everything the paper assumes before anything runs. Every problem is an
 //! [`Issue`] naming the field (TOML path, 0-based array index) and the reason.
 
-use super::schema::{
-    CouplingKind, MatrixSpec, ReferenceKind, RotationSpec, Scenario, SchemeKind,
-};
+use super::schema::{CouplingKind, MatrixSpec, ReferenceKind, RotationSpec, Scenario, SchemeKind};
 use attitude::body::Inertia;
 use attitude::checks::{
-    appendix_d_min_eigenvalue, has_distinct_eigenvalues, is_spd, p_is_admissible,
-    sym_eigenvalues, xi_plus_laplacian,
+    appendix_d_min_eigenvalue, has_distinct_eigenvalues, is_spd, p_is_admissible, sym_eigenvalues,
+    xi_plus_laplacian,
 };
 use attitude::control::ControlGains;
 use attitude::network::{AgentModel, AgentSpec, AgentState, Coupling, Neighbour, Network, Scheme};
@@ -194,7 +192,10 @@ impl Ctx {
         }
         let u = Vector3::from(axis);
         if u.iter().any(|x| !x.is_finite()) || u.norm() == 0.0 {
-            self.err(format!("{field}.axis"), format!("must be finite and non-zero, got {axis:?}"));
+            self.err(
+                format!("{field}.axis"),
+                format!("must be finite and non-zero, got {axis:?}"),
+            );
             return None;
         }
         Some(rot(angle, &u.normalize()))
@@ -210,7 +211,10 @@ impl Ctx {
         }
         let n = (x / dt).round();
         if n < 1.0 || (n * dt - x).abs() > 1e-9 * x.max(dt) {
-            self.err(field, format!("must be a whole multiple of simulation.dt = {dt}, got {x}"));
+            self.err(
+                field,
+                format!("must be a whole multiple of simulation.dt = {dt}, got {x}"),
+            );
             return None;
         }
         Some(n as u64)
@@ -238,11 +242,17 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
     let coupling = match (s.simulation.coupling, s.simulation.period) {
         (CouplingKind::Continuous, None) => Some(Coupling::Continuous),
         (CouplingKind::Continuous, Some(_)) => {
-            c.err("simulation.period", "is only used with coupling = \"sampled\"");
+            c.err(
+                "simulation.period",
+                "is only used with coupling = \"sampled\"",
+            );
             None
         }
         (CouplingKind::Sampled, None) => {
-            c.err("simulation.period", "is required with coupling = \"sampled\"");
+            c.err(
+                "simulation.period",
+                "is required with coupling = \"sampled\"",
+            );
             None
         }
         (CouplingKind::Sampled, Some(p)) => c
@@ -259,11 +269,17 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
     let observer = match (&s.scheme.observer, kind) {
         (None, SchemeKind::Observerless) => None,
         (Some(_), SchemeKind::Observerless) => {
-            c.warn("scheme.observer", "ignored: the observerless scheme has no observer");
+            c.warn(
+                "scheme.observer",
+                "ignored: the observerless scheme has no observer",
+            );
             None
         }
         (None, _) => {
-            c.err("scheme.observer", format!("is required by scheme {}", kind_name(kind)));
+            c.err(
+                "scheme.observer",
+                format!("is required by scheme {}", kind_name(kind)),
+            );
             None
         }
         (Some(o), _) => {
@@ -272,11 +288,17 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
                     c.positive("scheme.observer.k_sigma", k)
                 }
                 (None, SchemeKind::ObserverTimeVarying) => {
-                    c.err("scheme.observer.k_sigma", "is required by scheme observer-time-varying (eq. 7c)");
+                    c.err(
+                        "scheme.observer.k_sigma",
+                        "is required by scheme observer-time-varying (eq. 7c)",
+                    );
                     0.0
                 }
                 (Some(_), _) => {
-                    c.warn("scheme.observer.k_sigma", "ignored: observer 16a-16b has no σ̂");
+                    c.warn(
+                        "scheme.observer.k_sigma",
+                        "ignored: observer 16a-16b has no σ̂",
+                    );
                     0.0
                 }
                 (None, _) => 0.0,
@@ -306,7 +328,8 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
             let m = rows(&p);
             if m.iter().any(|x| !x.is_finite()) {
                 c.err("leader.p", "must hold finite numbers");
-            } else if (kind == SchemeKind::ObserverTimeVarying || l.reference == ReferenceKind::TimeVarying)
+            } else if (kind == SchemeKind::ObserverTimeVarying
+                || l.reference == ReferenceKind::TimeVarying)
                 && !p_is_admissible(&m)
             {
                 c.err(
@@ -320,7 +343,8 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
             m
         }
         None => {
-            if kind == SchemeKind::ObserverTimeVarying || l.reference == ReferenceKind::TimeVarying {
+            if kind == SchemeKind::ObserverTimeVarying || l.reference == ReferenceKind::TimeVarying
+            {
                 c.err("leader.p", "is required by a time-varying reference and by scheme observer-time-varying (eq. 7c)");
             }
             Matrix3::zeros()
@@ -332,14 +356,20 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
             let w0 = match &l.omega {
                 Some(w) => c.vec3("leader.omega", w),
                 None => {
-                    c.err("leader.omega", "is required by reference = \"time-varying\"");
+                    c.err(
+                        "leader.omega",
+                        "is required by reference = \"time-varying\"",
+                    );
                     Vector3::zeros()
                 }
             };
             let s0 = match &l.sigma {
                 Some(w) => c.vec3("leader.sigma", w),
                 None => {
-                    c.err("leader.sigma", "is required by reference = \"time-varying\"");
+                    c.err(
+                        "leader.sigma",
+                        "is required by reference = \"time-varying\"",
+                    );
                     Vector3::zeros()
                 }
             };
@@ -354,7 +384,10 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         ReferenceKind::Constant => {
             for (f, v) in [("leader.omega", &l.omega), ("leader.sigma", &l.sigma)] {
                 if v.is_some() {
-                    c.err(f, "must be absent for reference = \"constant\" (ω₀ = σ₀ = 0)");
+                    c.err(
+                        f,
+                        "must be absent for reference = \"constant\" (ω₀ = σ₀ = 0)",
+                    );
                 }
             }
             (Vector3::zeros(), Vector3::zeros())
@@ -367,7 +400,10 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         if a.id == 0 {
             c.err(format!("agent[{k}].id"), "must be ≥ 1 (id 0 is the leader)");
         } else if let Some(first) = ids.insert(a.id, k) {
-            c.err(format!("agent[{k}].id"), format!("duplicate id {} (also agent[{first}])", a.id));
+            c.err(
+                format!("agent[{k}].id"),
+                format!("duplicate id {} (also agent[{first}])", a.id),
+            );
             ids.insert(a.id, first);
         }
     }
@@ -382,17 +418,29 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         let w = c.vec3(&format!("{f}.omega"), &a.omega);
         let (a_bar, obs) = if kind == SchemeKind::Observerless {
             if a.control_gain.is_some() {
-                c.warn(format!("{f}.control_gain"), "ignored by the observerless scheme");
+                c.warn(
+                    format!("{f}.control_gain"),
+                    "ignored by the observerless scheme",
+                );
             }
             if a.observer.is_some() {
-                c.warn(format!("{f}.observer"), "ignored by the observerless scheme");
+                c.warn(
+                    format!("{f}.observer"),
+                    "ignored by the observerless scheme",
+                );
             }
-            (Some(Matrix3::identity()), Some((Matrix3::identity(), Vector3::zeros(), Vector3::zeros())))
+            (
+                Some(Matrix3::identity()),
+                Some((Matrix3::identity(), Vector3::zeros(), Vector3::zeros())),
+            )
         } else {
             let a_bar = match &a.control_gain {
                 Some(m) => c.gain(&format!("{f}.control_gain"), m),
                 None => {
-                    c.err(format!("{f}.control_gain"), format!("Āᵢ is required by scheme {}", kind_name(kind)));
+                    c.err(
+                        format!("{f}.control_gain"),
+                        format!("Āᵢ is required by scheme {}", kind_name(kind)),
+                    );
                     None
                 }
             };
@@ -401,13 +449,21 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
                     let rh = c.rotation(&format!("{f}.observer.attitude"), &o.attitude);
                     let wh = c.vec3(&format!("{f}.observer.omega"), &o.omega);
                     let sh = match (&o.sigma, kind) {
-                        (Some(sg), SchemeKind::ObserverTimeVarying) => c.vec3(&format!("{f}.observer.sigma"), sg),
+                        (Some(sg), SchemeKind::ObserverTimeVarying) => {
+                            c.vec3(&format!("{f}.observer.sigma"), sg)
+                        }
                         (None, SchemeKind::ObserverTimeVarying) => {
-                            c.err(format!("{f}.observer.sigma"), "σ̂ᵢ(0) is required by scheme observer-time-varying");
+                            c.err(
+                                format!("{f}.observer.sigma"),
+                                "σ̂ᵢ(0) is required by scheme observer-time-varying",
+                            );
                             Vector3::zeros()
                         }
                         (Some(_), _) => {
-                            c.warn(format!("{f}.observer.sigma"), "ignored: observer 16a-16b has no σ̂");
+                            c.warn(
+                                format!("{f}.observer.sigma"),
+                                "ignored: observer 16a-16b has no σ̂",
+                            );
                             Vector3::zeros()
                         }
                         (None, _) => Vector3::zeros(),
@@ -415,14 +471,33 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
                     rh.map(|rh| (rh, wh, sh))
                 }
                 None => {
-                    c.err(format!("{f}.observer"), format!("the observer's initial state is required by scheme {}", kind_name(kind)));
+                    c.err(
+                        format!("{f}.observer"),
+                        format!(
+                            "the observer's initial state is required by scheme {}",
+                            kind_name(kind)
+                        ),
+                    );
                     None
                 }
             };
             (a_bar, obs)
         };
         if let (Some(j), Some(r), Some(a_bar), Some((r_hat, w_hat, s_hat))) = (j, r, a_bar, obs) {
-            bodies.insert(a.id, (Inertia::new(j), a_bar, AgentState { r, w, r_hat, w_hat, s_hat }));
+            bodies.insert(
+                a.id,
+                (
+                    Inertia::new(j),
+                    a_bar,
+                    AgentState {
+                        r,
+                        w,
+                        r_hat,
+                        w_hat,
+                        s_hat,
+                    },
+                ),
+            );
         }
     }
 
@@ -437,7 +512,17 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         let mut ok = true;
         for x in [a, b] {
             if !ids.contains_key(&x) {
-                c.err(format!("{f}.agents"), format!("unknown agent id {x}{}", if x == 0 { " (the leader is linked with [[leader_link]], not [[edge]])" } else { "" }));
+                c.err(
+                    format!("{f}.agents"),
+                    format!(
+                        "unknown agent id {x}{}",
+                        if x == 0 {
+                            " (the leader is linked with [[leader_link]], not [[edge]])"
+                        } else {
+                            ""
+                        }
+                    ),
+                );
                 ok = false;
             }
         }
@@ -448,7 +533,10 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         let key = (a.min(b), a.max(b));
         if ok {
             if let Some(first) = first_edge.get(&key) {
-                c.err(format!("{f}.agents"), format!("duplicate edge {}–{} (also edge[{first}])", key.0, key.1));
+                c.err(
+                    format!("{f}.agents"),
+                    format!("duplicate edge {}–{} (also edge[{first}])", key.0, key.1),
+                );
                 ok = false;
             }
         }
@@ -475,11 +563,20 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         let f = format!("leader_link[{k}]");
         let g = c.gain(&format!("{f}.gain"), &l.gain);
         if !ids.contains_key(&l.agent) {
-            c.err(format!("{f}.agent"), format!("unknown agent id {}", l.agent));
+            c.err(
+                format!("{f}.agent"),
+                format!("unknown agent id {}", l.agent),
+            );
             continue;
         }
         if let Some(first) = link_seen.insert(l.agent, k) {
-            c.err(format!("{f}.agent"), format!("duplicate leader link to agent {} (also leader_link[{first}])", l.agent));
+            c.err(
+                format!("{f}.agent"),
+                format!(
+                    "duplicate leader link to agent {} (also leader_link[{first}])",
+                    l.agent
+                ),
+            );
             continue;
         }
         if let Some(g) = g {
@@ -487,7 +584,10 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         }
     }
     if s.leader_links.is_empty() {
-        c.err("leader_link", "at least one [[leader_link]] is required: no agent hears the leader");
+        c.err(
+            "leader_link",
+            "at least one [[leader_link]] is required: no agent hears the leader",
+        );
     }
 
     // Reachability from the leader (Assumption 1).
@@ -546,8 +646,17 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
             let mut neighbours: Vec<Neighbour> = edges
                 .iter()
                 .filter_map(|&(a, b)| {
-                    let other = if a == id { b } else if b == id { a } else { return None };
-                    Some(Neighbour { id: other, a: edge_gain[&(a, b)] })
+                    let other = if a == id {
+                        b
+                    } else if b == id {
+                        a
+                    } else {
+                        return None;
+                    };
+                    Some(Neighbour {
+                        id: other,
+                        a: edge_gain[&(a, b)],
+                    })
                 })
                 .collect();
             neighbours.sort_by_key(|n| n.id);
@@ -568,7 +677,11 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
     let network = Network {
         agents,
         p,
-        leader: LeaderState { r0: r0.expect("no errors"), w0, s0 },
+        leader: LeaderState {
+            r0: r0.expect("no errors"),
+            w0,
+            s0,
+        },
         dt,
         steps: steps.expect("no errors"),
         coupling: coupling.expect("no errors"),
@@ -604,7 +717,10 @@ fn sorted_eigs(m: &DMatrix<f64>) -> Vec<f64> {
 
 fn fmt_complex(m: &Matrix3<f64>) -> String {
     let ev = m.complex_eigenvalues();
-    let parts: Vec<String> = ev.iter().map(|z| format!("{:.4}{:+.4}i", z.re, z.im)).collect();
+    let parts: Vec<String> = ev
+        .iter()
+        .map(|z| format!("{:.4}{:+.4}i", z.re, z.im))
+        .collect();
     parts.join(", ")
 }
 
