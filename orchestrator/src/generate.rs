@@ -143,7 +143,7 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
             constant_leader(),
         ),
     };
-    Ok(Scenario {
+    let mut scenario = Scenario {
         name: Some(format!(
             "tree-{}-{}-seed{}",
             p.agents, p.leader_links, p.seed
@@ -164,7 +164,26 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
         leader_links,
         agents,
         edges,
-    })
+    };
+    raise_k_sigma_until_theorem_1_holds(&mut scenario);
+    Ok(scenario)
+}
+
+/// For scheme 1, doubles `k_σ` until the matrix F of Appendix D is positive
+/// definite (so that Theorem 1 covers the generated network). Deep trees
+/// need a larger `k_σ` than the paper's 12.
+fn raise_k_sigma_until_theorem_1_holds(s: &mut Scenario) {
+    for _ in 0..20 {
+        let Ok(r) = crate::scenario::resolve::resolve(s) else {
+            return;
+        };
+        match (r.appendix_d_min_eig, s.scheme.observer.as_mut()) {
+            (Some(m), Some(o)) if m <= 0.0 => {
+                o.k_sigma = o.k_sigma.map(|k| k * 2.0);
+            }
+            _ => return,
+        }
+    }
 }
 
 fn constant_leader() -> LeaderSpec {
