@@ -28,8 +28,8 @@ pub struct TreeParams {
 /// `P` of the paper's experiment: a decaying mode and an oscillating pair `±i/√2`.
 pub const PAPER_P: [[f64; 3]; 3] = [
     [-1.0, 0.0, 0.0],
-    [0.0, 0.0, -0.7071067811865475],
-    [0.0, 0.7071067811865476, 0.0],
+    [0.0, 0.0, -std::f64::consts::FRAC_1_SQRT_2],
+    [0.0, std::f64::consts::FRAC_1_SQRT_2, 0.0],
 ];
 
 /// A random tree: agent k ≥ 2 attaches to a uniformly chosen agent < k;

@@ -156,7 +156,15 @@ impl Ctx {
                 self.err(format!("{field}.quaternion"), "must be finite and non-zero");
                 return None;
             }
-            let q = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+            // Scale by the largest component first so that tiny or huge
+            // inputs normalise without underflow or overflow.
+            let m = q.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            let q = UnitQuaternion::from_quaternion(Quaternion::new(
+                q[0] / m,
+                q[1] / m,
+                q[2] / m,
+                q[3] / m,
+            ));
             return Some(*q.to_rotation_matrix().matrix());
         }
         if let Some(m) = r.matrix {
@@ -191,18 +199,18 @@ impl Ctx {
             return None;
         }
         let u = Vector3::from(axis);
-        if u.iter().any(|x| !x.is_finite()) || u.norm() == 0.0 {
+        if u.iter().any(|x| !x.is_finite()) || u.amax() == 0.0 {
             self.err(
                 format!("{field}.axis"),
                 format!("must be finite and non-zero, got {axis:?}"),
             );
             return None;
         }
-        Some(rot(angle, &u.normalize()))
+        Some(rot(angle, &(u / u.amax()).normalize()))
     }
 
     fn multiple_of_dt(&mut self, field: &str, x: f64, dt: f64) -> Option<u64> {
-        if !self.finite(field, x) || !(dt > 0.0 && dt.is_finite()) {
+        if !(self.finite(field, x) && dt > 0.0 && dt.is_finite()) {
             return None;
         }
         if x <= 0.0 {
@@ -210,6 +218,13 @@ impl Ctx {
             return None;
         }
         let n = (x / dt).round();
+        if n > MAX_STEPS {
+            self.err(
+                field,
+                format!("{x} s is {n:e} steps of simulation.dt = {dt}; at most {MAX_STEPS:e} are allowed"),
+            );
+            return None;
+        }
         if n < 1.0 || (n * dt - x).abs() > 1e-9 * x.max(dt) {
             self.err(
                 field,
@@ -221,6 +236,10 @@ impl Ctx {
     }
 }
 
+/// Most steps a run (or a period) may have: 2⁴⁰ ≈ 1.1e12, far beyond any
+/// useful run, well inside u64 and f64's exact integers.
+const MAX_STEPS: f64 = 1_099_511_627_776.0;
+
 fn rows(r: &[[f64; 3]; 3]) -> Matrix3<f64> {
     Matrix3::new(
         r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2],
@@ -231,6 +250,20 @@ fn rows(r: &[[f64; 3]; 3]) -> Matrix3<f64> {
 /// found (not only the first).
 pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
     let mut c = Ctx::default();
+
+    if let Some(name) = &s.name {
+        let mut parts = std::path::Path::new(name).components();
+        let plain = matches!(
+            (parts.next(), parts.next()),
+            (Some(std::path::Component::Normal(_)), None)
+        );
+        if !plain || name.contains(['/', '\\']) {
+            c.err(
+                "name",
+                format!("{name:?} must be a plain directory name (no separators, not . or ..): it names the results directory"),
+            );
+        }
+    }
 
     // [simulation], [output]
     let dt = s.simulation.dt;

@@ -1,0 +1,79 @@
+//! `attsync-agent`: one rigid body as its own OS process. It talks only to
+//! its graph neighbours (and the leader, if linked) over iceoryx2 shared
+//! memory, in lockstep, and reports telemetry to the orchestrator.
+//!
+//! # Layout
+//! - [`runtime`]: the lockstep node loop shared with the leader process.
+//! - [`wait`]: waiting strategies.
+//! - [`args`]: the command line shared by the agent and leader binaries.
+//! - [`AgentNode`]: the model ([`attitude::agent::Agent`]) behind the loop.
+
+pub mod args;
+pub mod runtime;
+pub mod wait;
+
+use attitude::agent::Agent;
+use attitude::network::Exchanged;
+use iceoryx2::node::Node;
+use iceoryx2::service::Service;
+use msgs::TelemetryMsg;
+use msgs::config::{NodeConfig, Role};
+pub use runtime::{NodeError, Stepper};
+use std::sync::atomic::AtomicBool;
+
+/// An agent behind the node loop. Inputs are its neighbours in id order,
+/// then the leader if linked (as in [`NodeConfig::inputs`]).
+#[derive(Debug)]
+pub struct AgentNode {
+    agent: Agent,
+    id: u32,
+}
+
+impl AgentNode {
+    /// Builds the agent of `cfg` (which must have an agent role).
+    pub fn from_config(cfg: &NodeConfig) -> Result<Self, String> {
+        match &cfg.role {
+            Role::Agent { model, initial } => Ok(Self {
+                agent: Agent::new((**model).clone(), *initial, cfg.dt),
+                id: cfg.id,
+            }),
+            Role::Leader { .. } => Err(format!("node {} is configured as the leader", cfg.id)),
+        }
+    }
+}
+
+impl Stepper for AgentNode {
+    fn stage_exchange(&self) -> Exchanged {
+        self.agent.stage_exchange()
+    }
+
+    fn receive(&mut self, k: usize, x: Exchanged) {
+        if k < self.agent.model().neighbours.len() {
+            self.agent.receive_neighbour(k, x);
+        } else {
+            self.agent.receive_leader(x);
+        }
+    }
+
+    fn advance(&mut self) {
+        self.agent.advance();
+    }
+
+    fn sample(&self, step: u64) -> TelemetryMsg {
+        TelemetryMsg::agent(self.id, step, self.agent.state(), self.agent.peak_torque())
+    }
+
+    fn peak_torque(&self) -> f64 {
+        self.agent.peak_torque()
+    }
+}
+
+/// Runs the agent of `cfg` on `node` until the end of the protocol.
+pub fn run<S: Service>(
+    node: &Node<S>,
+    cfg: &NodeConfig,
+    shutdown: &AtomicBool,
+) -> Result<(), NodeError> {
+    let mut a = AgentNode::from_config(cfg).map_err(NodeError::Protocol)?;
+    runtime::run(node, cfg, &mut a, shutdown)
+}

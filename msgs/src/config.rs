@@ -1,0 +1,106 @@
+//! The configuration a node process receives: one JSON file per node
+//! (`--config FILE`), written by the orchestrator. f64 values round-trip
+//! exactly (shortest representation, parsed with correct rounding), so a
+//! node computes bit-identical results to the in-process engine.
+
+use crate::open::Limits;
+use attitude::network::{AgentModel, AgentState, Coupling};
+use attitude::reference::LeaderState;
+use nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// How a node waits for the messages a stage needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WaitStrategy {
+    /// Busy-poll the subscribers.
+    Spin,
+    /// Poll, calling `sched_yield` between polls.
+    Yield,
+    /// Sleep on the node's wake event (1 ms slices; re-poll after every wake).
+    Block,
+    /// Yield for a short while, then block.
+    Adaptive,
+}
+
+/// What the node is.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Role {
+    /// The virtual leader 0.
+    Leader {
+        /// Generator `P`.
+        p: Matrix3<f64>,
+        /// State at t = 0.
+        initial: LeaderState,
+    },
+    /// A follower.
+    Agent {
+        /// What the agent knows.
+        model: Box<AgentModel>,
+        /// State at t = 0.
+        initial: AgentState,
+    },
+}
+
+/// Everything one node process needs to know.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NodeConfig {
+    /// [`crate::PROTOCOL_VERSION`] the orchestrator speaks.
+    pub protocol_version: u32,
+    /// Run id: the service namespace `attsync/<run>/` and the iceoryx2 prefix.
+    pub run: String,
+    /// iceoryx2 root path of the run.
+    pub iox_root: String,
+    /// Node id (0 = leader).
+    pub id: u32,
+    /// Integrator step, s.
+    pub dt: f64,
+    /// Steps to do.
+    pub steps: u64,
+    /// Exchange schedule.
+    pub coupling: Coupling,
+    /// Telemetry every this many steps (and at the last step).
+    pub sample_every: u64,
+    /// Ids whose state this node reads, in the order the model expects
+    /// (neighbours by id, then the leader 0 if linked).
+    pub inputs: Vec<u32>,
+    /// Ids that read this node's state (to wake them).
+    pub outputs: Vec<u32>,
+    /// Service limits of the run.
+    pub limits: Limits,
+    /// Waiting strategy.
+    pub wait: WaitStrategy,
+    /// Longest wait for one stage's inputs before giving up, s.
+    pub stage_timeout: f64,
+    /// Longest wait for connections and the start command, s.
+    pub start_timeout: f64,
+    /// The node's role and model.
+    pub role: Role,
+}
+
+impl NodeConfig {
+    /// Reads a config file.
+    pub fn read(path: &Path) -> Result<Self, String> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let cfg: Self = serde_json::from_str(&text)
+            .map_err(|e| format!("{}: invalid node config: {e}", path.display()))?;
+        if cfg.protocol_version != crate::PROTOCOL_VERSION {
+            return Err(format!(
+                "{}: protocol version {} but this program speaks {}",
+                path.display(),
+                cfg.protocol_version,
+                crate::PROTOCOL_VERSION
+            ));
+        }
+        Ok(cfg)
+    }
+
+    /// Writes a config file.
+    pub fn write(&self, path: &Path) -> Result<(), String> {
+        let text = serde_json::to_string_pretty(self).expect("a config serialises");
+        std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+    }
+}

@@ -1,0 +1,30 @@
+//! Per-run iceoryx2 isolation: every file a run creates carries the prefix
+//! `as<run>_` (in /dev/shm and elsewhere) and lives under the root path
+//! `<base>/<run>/`, so two runs, or parallel tests, never meet, and a run's
+//! leftovers can be removed by name.
+
+use iceoryx2::config::Config;
+use iceoryx2::prelude::{FileName, Path, SemanticString};
+
+/// The iceoryx2 file prefix of run `run`.
+#[must_use]
+pub fn prefix(run: &str) -> String {
+    format!("as{run}_")
+}
+
+/// The iceoryx2 configuration of a run: prefix [`prefix`], root path `root`
+/// (a directory that belongs to the run, with a trailing `/`).
+pub fn config(run: &str, root: &std::path::Path) -> Result<Config, String> {
+    let mut cfg = Config::default();
+    cfg.global.prefix = FileName::new(prefix(run).as_bytes())
+        .map_err(|e| format!("run id {run:?} makes an invalid iceoryx2 prefix: {e:?}"))?;
+    let mut root = root.to_string_lossy().into_owned();
+    if !root.ends_with('/') {
+        root.push('/');
+    }
+    cfg.global.set_root_path(
+        &Path::new(root.as_bytes())
+            .map_err(|e| format!("invalid iceoryx2 root path {root:?}: {e:?}"))?,
+    );
+    Ok(cfg)
+}
