@@ -8,6 +8,7 @@
 //! - [`generate`]: generated scenarios (random trees).
 
 pub mod generate;
+pub mod processes;
 pub mod results;
 pub mod run;
 pub mod scenario;

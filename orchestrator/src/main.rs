@@ -2,9 +2,11 @@
 
 use anyhow::Context;
 use attsync::generate::{TreeParams, tree};
+use attsync::processes::ProcessOptions;
 use attsync::run::{Engine, RunOptions, run};
 use attsync::scenario::{self, ScenarioError, schema::SchemeKind};
 use clap::{Parser, Subcommand, ValueEnum};
+use msgs::config::WaitStrategy;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,8 +36,14 @@ enum Command {
         /// Scenario file (TOML).
         scenario: PathBuf,
         /// Engine.
-        #[arg(long, value_enum, default_value_t = Engine::InProcess)]
+        #[arg(long, value_enum, default_value_t = Engine::Processes)]
         engine: Engine,
+        /// How node processes wait for their inputs (processes engine).
+        #[arg(long, value_enum, default_value_t = WaitArg::Adaptive)]
+        wait: WaitArg,
+        /// Longest wait of a node for one stage's inputs, s (processes engine).
+        #[arg(long, default_value_t = 10.0)]
+        stage_timeout: f64,
         /// Results directory [default: results/<scenario name>].
         #[arg(long)]
         out: Option<PathBuf>,
@@ -79,6 +87,18 @@ enum Gen {
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
+enum WaitArg {
+    /// Busy-poll.
+    Spin,
+    /// Poll with sched_yield.
+    Yield,
+    /// Sleep on iceoryx2 events (1 ms slices).
+    Block,
+    /// Yield a while, then block.
+    Adaptive,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
 enum SchemeArg {
     ObserverTimeVarying,
     ObserverConstant,
@@ -110,6 +130,8 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Run {
             scenario,
             engine,
+            wait,
+            stage_timeout,
             out,
             set,
             quiet,
@@ -123,18 +145,32 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             let flag = interrupt.clone();
             ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
                 .context("installing the Ctrl-C handler")?;
+            let wait = match wait {
+                WaitArg::Spin => WaitStrategy::Spin,
+                WaitArg::Yield => WaitStrategy::Yield,
+                WaitArg::Block => WaitStrategy::Block,
+                WaitArg::Adaptive => WaitStrategy::Adaptive,
+            };
             let opts = RunOptions {
                 engine,
                 out: out.clone(),
+                processes: ProcessOptions {
+                    wait,
+                    stage_timeout,
+                    ..ProcessOptions::default()
+                },
                 progress: !quiet && std::io::stderr().is_terminal(),
             };
             let summary = run(&loaded, &opts, &interrupt)?;
             println!("{}", summary.table());
             println!("results: {}", out.display());
-            Ok(if summary.complete {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(130)
+            Ok(match summary.incomplete_reason.as_deref() {
+                None => ExitCode::SUCCESS,
+                Some("interrupted") => ExitCode::from(130),
+                Some(reason) => {
+                    eprintln!("error: the run failed: {reason}");
+                    ExitCode::from(1)
+                }
             })
         }
         Command::Gen {

@@ -1,6 +1,7 @@
 //! `attsync run`: a loaded scenario through an engine into a results
 //! directory.
 
+use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::results::{self, Recorder, Summary, plot, staging::Staging};
 use crate::scenario::Loaded;
 use attitude::engine::InProcess;
@@ -13,6 +14,8 @@ use thiserror::Error;
 /// Which engine runs the network.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Engine {
+    /// One OS process per node (leader and agents), iceoryx2 in lockstep.
+    Processes,
     /// Every node in the orchestrator's process, in lockstep.
     InProcess,
 }
@@ -22,6 +25,7 @@ impl Engine {
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
+            Engine::Processes => "processes",
             Engine::InProcess => "in-process",
         }
     }
@@ -34,6 +38,8 @@ pub struct RunOptions {
     pub engine: Engine,
     /// Results directory.
     pub out: PathBuf,
+    /// Process-engine options.
+    pub processes: ProcessOptions,
     /// Draw a progress bar on stderr (it also hides itself when stderr is not a terminal).
     pub progress: bool,
 }
@@ -49,6 +55,9 @@ pub enum RunError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// The process engine could not start.
+    #[error(transparent)]
+    Processes(#[from] ProcessError),
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -83,36 +92,51 @@ pub fn run(
 
     let bar = progress_bar(opts.progress, net.steps, net.dt);
     let started = Instant::now();
-    let mut engine = InProcess::new(net);
     let mut write_error = None;
-    let mut interrupted = false;
-    engine.run(|snap| {
+    let mut record = |snap: &attitude::engine::Snapshot<'_>| {
         if let Err(e) = recorder.record(snap) {
             write_error = Some(e);
             return false;
         }
         bar.set_position(snap.step);
-        if interrupt.load(Ordering::Relaxed) {
-            interrupted = true;
-            return false;
-        }
         true
-    });
+    };
+    let (peaks, steps, failure) = match opts.engine {
+        Engine::InProcess => {
+            let mut engine = InProcess::new(net);
+            let mut interrupted = false;
+            engine.run(|snap| {
+                if interrupt.load(Ordering::Relaxed) {
+                    interrupted = true;
+                    return false;
+                }
+                record(snap)
+            });
+            let peaks = engine.agents().iter().map(|a| a.peak_torque()).collect();
+            (
+                peaks,
+                engine.step_index(),
+                interrupted.then(|| "interrupted".to_string()),
+            )
+        }
+        Engine::Processes => {
+            let out = processes::run(net, &opts.processes, &dir.join("logs"), interrupt, record)?;
+            (out.peak_torques, out.steps, out.failure)
+        }
+    };
     let wall_seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
     if let Some(e) = write_error {
         return Err(io_at(&dir)(e));
     }
     let series = recorder.finish().map_err(io_at(&dir))?;
-    let peaks: Vec<f64> = engine.agents().iter().map(|a| a.peak_torque()).collect();
     let agents = results::agent_summaries(&series, &peaks);
-    let steps = engine.step_index();
     let summary = Summary {
         attsync_version: env!("CARGO_PKG_VERSION").into(),
         scenario: loaded.name(),
         engine: opts.engine.name().into(),
-        complete: !interrupted && steps == net.steps,
-        incomplete_reason: interrupted.then(|| "interrupted".to_string()),
+        complete: failure.is_none() && steps == net.steps,
+        incomplete_reason: failure,
         dt: net.dt,
         duration: net.steps as f64 * net.dt,
         t_end: steps as f64 * net.dt,

@@ -1,0 +1,437 @@
+//! The process-per-agent engine: the leader and every agent run as their own
+//! OS processes (`attsync-leader`, `attsync-agent`), exchanging states over
+//! iceoryx2 in lockstep; the orchestrator supervises them, collects their
+//! telemetry into the same snapshots the in-process engine produces, and
+//! removes everything the run created.
+
+pub mod namespace;
+pub mod supervise;
+
+use attitude::engine::Snapshot;
+use attitude::network::{AgentState, Network};
+use attitude::reference::LeaderState;
+use iceoryx2::node::NodeBuilder;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use msgs::config::{NodeConfig, Role, WaitStrategy};
+use msgs::{ControlCommand, ControlMsg, Limits, PROTOCOL_VERSION, TelemetryKind, TelemetryMsg};
+use namespace::Namespace;
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+use supervise::{Supervisor, describe, find_binaries, tail};
+use thiserror::Error;
+
+/// Options of the process engine.
+#[derive(Debug, Clone)]
+pub struct ProcessOptions {
+    /// How nodes wait for their inputs.
+    pub wait: WaitStrategy,
+    /// Longest wait of a node for one stage's inputs, s.
+    pub stage_timeout: f64,
+    /// Longest wait for connections and commands, s.
+    pub start_timeout: f64,
+}
+
+impl Default for ProcessOptions {
+    fn default() -> Self {
+        Self {
+            wait: WaitStrategy::Adaptive,
+            stage_timeout: 10.0,
+            start_timeout: 30.0,
+        }
+    }
+}
+
+/// The engine could not start.
+#[derive(Debug, Error)]
+pub enum ProcessError {
+    /// A node binary is missing.
+    #[error("{0}")]
+    MissingBinary(String),
+    /// Setting up iceoryx2 failed.
+    #[error("iceoryx2: {0}")]
+    Iceoryx(String),
+    /// A file could not be written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+/// How a process run ended.
+#[derive(Debug)]
+pub struct Outcome {
+    /// Peak torque per agent (network order); 0 where never reported.
+    pub peak_torques: Vec<f64>,
+    /// Steps of the last complete snapshot.
+    pub steps: u64,
+    /// Why the run stopped early, if it did.
+    pub failure: Option<String>,
+}
+
+fn iox<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ProcessError {
+    move |e| ProcessError::Iceoryx(format!("{what}: {e:?}"))
+}
+
+/// Node names: `leader`, `agent-<id>`.
+fn node_name(net: &Network, index: usize) -> String {
+    if index == 0 {
+        "leader".into()
+    } else {
+        format!("agent-{}", net.agents[index - 1].model.id)
+    }
+}
+
+/// The per-node configurations of `net`.
+#[must_use]
+pub fn node_configs(
+    net: &Network,
+    run: &str,
+    root: &Path,
+    opts: &ProcessOptions,
+) -> Vec<NodeConfig> {
+    let limits = Limits::of(net);
+    let linked: Vec<u32> = net
+        .agents
+        .iter()
+        .filter(|a| a.model.leader_gain.is_some())
+        .map(|a| a.model.id)
+        .collect();
+    let base = |id: u32, inputs: Vec<u32>, outputs: Vec<u32>, role: Role| NodeConfig {
+        protocol_version: PROTOCOL_VERSION,
+        run: run.to_string(),
+        iox_root: root.to_string_lossy().into_owned(),
+        id,
+        dt: net.dt,
+        steps: net.steps,
+        coupling: net.coupling,
+        sample_every: net.sample_every,
+        inputs,
+        outputs,
+        limits,
+        wait: opts.wait,
+        stage_timeout: opts.stage_timeout,
+        start_timeout: opts.start_timeout,
+        role,
+    };
+    let mut out = vec![base(
+        0,
+        Vec::new(),
+        linked,
+        Role::Leader {
+            p: net.p,
+            initial: net.leader,
+        },
+    )];
+    for a in &net.agents {
+        let nbrs: Vec<u32> = a.model.neighbours.iter().map(|n| n.id).collect();
+        let mut inputs = nbrs.clone();
+        if a.model.leader_gain.is_some() {
+            inputs.push(0);
+        }
+        out.push(base(
+            a.model.id,
+            inputs,
+            nbrs,
+            Role::Agent {
+                model: Box::new(a.model.clone()),
+                initial: a.initial,
+            },
+        ));
+    }
+    out
+}
+
+/// Runs `net` as processes. `logs` receives one log file per node.
+/// `on_sample` gets every snapshot in step order (return `false` to stop).
+/// Failures after start-up (a node dies, a timeout, `interrupt`) end the run
+/// early with [`Outcome::failure`] set; everything is cleaned up in all cases.
+pub fn run(
+    net: &Network,
+    opts: &ProcessOptions,
+    logs: &Path,
+    interrupt: &AtomicBool,
+    mut on_sample: impl FnMut(&Snapshot<'_>) -> bool,
+) -> Result<Outcome, ProcessError> {
+    let (agent_bin, leader_bin) = find_binaries().map_err(ProcessError::MissingBinary)?;
+    let io = |path: &Path| {
+        let path = path.to_owned();
+        move |source| ProcessError::Io { path, source }
+    };
+    std::fs::create_dir_all(logs).map_err(io(logs))?;
+    let ns = Namespace::create().map_err(io(&namespace::base_dir()))?;
+    let run = ns.run().to_string();
+    let limits = Limits::of(net);
+    let n_nodes = net.agents.len() + 1;
+
+    set_log_level(LogLevel::Error);
+    let cfg = msgs::namespace::config(&run, ns.dir()).map_err(ProcessError::Iceoryx)?;
+    let node = NodeBuilder::new()
+        .name(&"orchestrator".try_into().map_err(iox("node name"))?)
+        .config(&cfg)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(iox("node"))?;
+    let control = msgs::open::control(&node, &run, &limits)
+        .map_err(|e| ProcessError::Iceoryx(e.to_string()))?
+        .publisher_builder()
+        .create()
+        .map_err(iox("control publisher"))?;
+    let listener = msgs::open::orchestrator_wake(&node, &run, &limits)
+        .map_err(|e| ProcessError::Iceoryx(e.to_string()))?
+        .listener_builder()
+        .create()
+        .map_err(iox("wake listener"))?;
+    let configs = node_configs(net, &run, ns.dir(), opts);
+    let mut telemetry: Vec<Subscriber<ipc::Service, TelemetryMsg, ()>> = Vec::new();
+    for c in &configs {
+        telemetry.push(
+            msgs::open::telemetry(&node, &run, c.id, &limits)
+                .map_err(|e| ProcessError::Iceoryx(e.to_string()))?
+                .subscriber_builder()
+                .buffer_size(limits.telemetry_buffer)
+                .create()
+                .map_err(iox("telemetry subscriber"))?,
+        );
+    }
+
+    let mut sup = Supervisor::new().map_err(io(Path::new("tokio runtime")))?;
+    let log_of = |i: usize| logs.join(format!("{}.log", node_name(net, i)));
+    for (i, c) in configs.iter().enumerate() {
+        let file = ns.dir().join(format!("node-{}.json", c.id));
+        c.write(&file).map_err(|e| ProcessError::Io {
+            path: file.clone(),
+            source: std::io::Error::other(e),
+        })?;
+        let bin = if i == 0 { &leader_bin } else { &agent_bin };
+        sup.spawn(
+            i,
+            bin,
+            &["--config".into(), file.to_string_lossy().into_owned()],
+            &log_of(i),
+        )
+        .map_err(io(&log_of(i)))?;
+    }
+
+    let mut c = Collector {
+        pending: vec![VecDeque::new(); n_nodes],
+        ready: vec![false; n_nodes],
+        done: vec![false; n_nodes],
+        peaks: vec![0.0; n_nodes],
+        steps: 0,
+    };
+    let failure = (|| -> Option<String> {
+        // Phase 1: every node ready.
+        let deadline = Instant::now() + Duration::from_secs_f64(opts.start_timeout);
+        while !c.ready.iter().all(|&r| r) {
+            let _ = listener.timed_wait(|_| {}, Duration::from_millis(10));
+            if let Err(e) = c.drain(&telemetry) {
+                return Some(e);
+            }
+            if let Some(f) = check_exits(&mut sup, &c.done, net, &log_of) {
+                return Some(f);
+            }
+            if interrupt.load(Ordering::Relaxed) {
+                return Some("interrupted".into());
+            }
+            if Instant::now() > deadline {
+                let missing: Vec<String> = (0..n_nodes)
+                    .filter(|&i| !c.ready[i])
+                    .map(|i| node_name(net, i))
+                    .collect();
+                return Some(format!(
+                    "start-up timed out after {} s: not ready: {}",
+                    opts.start_timeout,
+                    missing.join(", ")
+                ));
+            }
+        }
+        if control
+            .send_copy(ControlMsg::new(ControlCommand::Start))
+            .is_err()
+        {
+            return Some("cannot send Start".into());
+        }
+        // Phase 2: collect until every node is done.
+        let stall = Duration::from_secs_f64(opts.stage_timeout * 2.0);
+        let mut last_progress = Instant::now();
+        loop {
+            let _ = listener.timed_wait(|_| {}, Duration::from_millis(10));
+            match c.drain(&telemetry) {
+                Ok(true) => last_progress = Instant::now(),
+                Ok(false) => {}
+                Err(e) => return Some(e),
+            }
+            loop {
+                match c.next_snapshot(net) {
+                    Ok(Some((step, leader, agents))) => {
+                        c.steps = step;
+                        let snap = Snapshot {
+                            step,
+                            leader: &leader,
+                            agents: &agents,
+                        };
+                        if !on_sample(&snap) {
+                            return Some("stopped by the results writer".into());
+                        }
+                    }
+                    Ok(None) => break,
+                    Err(e) => return Some(e),
+                }
+            }
+            if c.done.iter().all(|&d| d) && c.pending.iter().all(VecDeque::is_empty) {
+                return None;
+            }
+            if let Some(f) = check_exits(&mut sup, &c.done, net, &log_of) {
+                return Some(f);
+            }
+            if interrupt.load(Ordering::Relaxed) {
+                return Some("interrupted".into());
+            }
+            if last_progress.elapsed() > stall {
+                return Some(format!(
+                    "no telemetry for {:.0} s: the run is stalled",
+                    stall.as_secs_f64()
+                ));
+            }
+        }
+    })();
+
+    match &failure {
+        None => {
+            let _ = control.send_copy(ControlMsg::new(ControlCommand::Stop));
+            let exits = sup.wait_all(Duration::from_secs(10));
+            let bad: Vec<String> = exits
+                .iter()
+                .filter(|e| !matches!(&e.status, Ok(s) if s.success()))
+                .map(|e| format!("{}: {}", node_name(net, e.index), describe(&e.status)))
+                .collect();
+            if !bad.is_empty() {
+                return Ok(Outcome {
+                    peak_torques: c.peaks[1..].to_vec(),
+                    steps: c.steps,
+                    failure: Some(format!("nodes failed at shutdown: {}", bad.join("; "))),
+                });
+            }
+        }
+        Some(_) => {
+            sup.kill_all();
+            let _ = sup.wait_all(Duration::from_secs(5));
+        }
+    }
+    drop(telemetry);
+    drop(control);
+    drop(listener);
+    drop(node);
+    drop(ns);
+    Ok(Outcome {
+        peak_torques: c.peaks[1..].to_vec(),
+        steps: c.steps,
+        failure,
+    })
+}
+
+/// A node that exited before it was done is a failure: name it, its status
+/// and the end of its log.
+fn check_exits(
+    sup: &mut Supervisor,
+    done: &[bool],
+    net: &Network,
+    log_of: &dyn Fn(usize) -> PathBuf,
+) -> Option<String> {
+    while let Some(e) = sup.try_exit() {
+        let clean = matches!(&e.status, Ok(s) if s.success());
+        if !(done[e.index] && clean) {
+            return Some(format!(
+                "{} ended during the run ({}); last lines of {}:\n{}",
+                node_name(net, e.index),
+                describe(&e.status),
+                log_of(e.index).display(),
+                tail(&log_of(e.index), 10)
+            ));
+        }
+    }
+    None
+}
+
+/// Telemetry bookkeeping.
+struct Collector {
+    pending: Vec<VecDeque<TelemetryMsg>>,
+    ready: Vec<bool>,
+    done: Vec<bool>,
+    peaks: Vec<f64>,
+    steps: u64,
+}
+
+impl Collector {
+    /// Reads every telemetry message available; `Ok(true)` if any arrived.
+    fn drain(
+        &mut self,
+        subs: &[Subscriber<ipc::Service, TelemetryMsg, ()>],
+    ) -> Result<bool, String> {
+        let mut any = false;
+        for (i, sub) in subs.iter().enumerate() {
+            loop {
+                let m = match sub.receive() {
+                    Ok(Some(s)) => *s,
+                    Ok(None) => break,
+                    Err(e) => return Err(format!("telemetry receive: {e:?}")),
+                };
+                any = true;
+                if m.version != PROTOCOL_VERSION {
+                    return Err(format!(
+                        "node {} speaks protocol version {}, attsync {PROTOCOL_VERSION}",
+                        m.sender, m.version
+                    ));
+                }
+                match TelemetryKind::from_u32(m.kind) {
+                    Some(TelemetryKind::Ready) => self.ready[i] = true,
+                    Some(TelemetryKind::Sample) => self.pending[i].push_back(m),
+                    Some(TelemetryKind::Done) => {
+                        self.done[i] = true;
+                        self.peaks[i] = m.peak_torque;
+                    }
+                    None => {
+                        return Err(format!(
+                            "node {} sent telemetry of unknown kind {}",
+                            m.sender, m.kind
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(any)
+    }
+
+    /// The next complete snapshot, if every node has sent it.
+    #[allow(clippy::type_complexity)]
+    fn next_snapshot(
+        &mut self,
+        _net: &Network,
+    ) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, String> {
+        if self.pending.iter().any(VecDeque::is_empty) {
+            return Ok(None);
+        }
+        let step = self.pending[0][0].step;
+        if let Some(m) = self.pending.iter().map(|q| &q[0]).find(|m| m.step != step) {
+            return Err(format!(
+                "telemetry out of step: node {} at step {}, leader at {step}",
+                m.sender, m.step
+            ));
+        }
+        let leader = self.pending[0]
+            .pop_front()
+            .expect("non-empty")
+            .leader_state();
+        let agents = self.pending[1..]
+            .iter_mut()
+            .map(|q| q.pop_front().expect("non-empty").agent_state())
+            .collect();
+        Ok(Some((step, leader, agents)))
+    }
+}

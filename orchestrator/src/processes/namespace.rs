@@ -1,0 +1,119 @@
+//! A run's iceoryx2 namespace on this machine: a root directory
+//! `<tmp>/attsync-iox2/<run>/` and the file prefix `as<run>_` (see
+//! [`msgs::namespace`]). Removing both removes everything the run created;
+//! namespaces whose owner process is gone are removed on start.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// Where shared-memory segments live.
+const SHM_DIR: &str = "/dev/shm";
+
+/// The namespace of one run. Removed on drop.
+#[derive(Debug)]
+pub struct Namespace {
+    run: String,
+    dir: PathBuf,
+}
+
+/// Parent directory of every run's namespace.
+#[must_use]
+pub fn base_dir() -> PathBuf {
+    std::env::temp_dir().join("attsync-iox2")
+}
+
+impl Namespace {
+    /// Creates a fresh namespace with a unique run id, after removing stale
+    /// namespaces of dead runs.
+    pub fn create() -> std::io::Result<Self> {
+        static COUNTER: AtomicU32 = AtomicU32::new(0);
+        remove_stale();
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let run = format!(
+            "{:x}r{:x}r{:x}",
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed),
+            nanos & 0xffff
+        );
+        let dir = base_dir().join(&run);
+        fs::create_dir_all(&dir)?;
+        fs::write(dir.join("owner"), std::process::id().to_string())?;
+        Ok(Self { run, dir })
+    }
+
+    /// The run id.
+    #[must_use]
+    pub fn run(&self) -> &str {
+        &self.run
+    }
+
+    /// The iceoryx2 root path (and where node configs are written).
+    #[must_use]
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Every file of this run still present (shared memory and root dir).
+    #[must_use]
+    pub fn leftovers(run: &str) -> Vec<PathBuf> {
+        let mut out = shm_files(run);
+        let dir = base_dir().join(run);
+        if dir.exists() {
+            out.push(dir);
+        }
+        out
+    }
+}
+
+impl Drop for Namespace {
+    fn drop(&mut self) {
+        remove(&self.run);
+    }
+}
+
+fn shm_files(run: &str) -> Vec<PathBuf> {
+    let prefix = msgs::namespace::prefix(run);
+    fs::read_dir(SHM_DIR)
+        .map(|rd| {
+            rd.filter_map(Result::ok)
+                .filter(|e| e.file_name().to_string_lossy().starts_with(&prefix))
+                .map(|e| e.path())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Removes run `run`'s shared memory and root directory.
+pub fn remove(run: &str) {
+    for f in shm_files(run) {
+        let _ = fs::remove_file(f);
+    }
+    let _ = fs::remove_dir_all(base_dir().join(run));
+}
+
+/// Removes the namespaces whose owner process no longer exists.
+pub fn remove_stale() {
+    let Ok(rd) = fs::read_dir(base_dir()) else {
+        return;
+    };
+    for e in rd.filter_map(Result::ok) {
+        let run = e.file_name().to_string_lossy().into_owned();
+        let owner = fs::read_to_string(e.path().join("owner")).ok();
+        let alive = owner
+            .and_then(|p| p.trim().parse::<u32>().ok())
+            .is_some_and(|pid| Path::new(&format!("/proc/{pid}")).exists());
+        if !alive {
+            tracing_free_log(&format!("removing stale iceoryx2 namespace of run {run}"));
+            remove(&run);
+        }
+    }
+}
+
+fn tracing_free_log(msg: &str) {
+    if std::env::var_os("ATTSYNC_DEBUG").is_some() {
+        eprintln!("attsync: {msg}");
+    }
+}

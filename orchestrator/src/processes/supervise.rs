@@ -1,0 +1,213 @@
+//! Process supervision with tokio: start the node processes (each in its own
+//! process group, output to its log file), report every exit as soon as it
+//! happens, kill them all on demand.
+
+use std::os::unix::process::ExitStatusExt;
+use std::path::{Path, PathBuf};
+use std::process::{ExitStatus, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+use tokio::sync::watch;
+
+/// One node process that ended.
+#[derive(Debug)]
+pub struct Exit {
+    /// Index of the node (0 = leader, then agents in network order).
+    pub index: usize,
+    /// How it ended (or why it could not start).
+    pub status: Result<ExitStatus, String>,
+}
+
+/// Describes an exit status: `exit code 1`, `killed by signal 9 (SIGKILL)`.
+#[must_use]
+pub fn describe(status: &Result<ExitStatus, String>) -> String {
+    match status {
+        Err(e) => format!("could not start: {e}"),
+        Ok(s) => match (s.code(), s.signal()) {
+            (Some(c), _) => format!("exit code {c}"),
+            (None, Some(sig)) => format!("killed by signal {sig}{}", signal_name(sig)),
+            _ => format!("{s}"),
+        },
+    }
+}
+
+fn signal_name(sig: i32) -> &'static str {
+    match sig {
+        1 => " (SIGHUP)",
+        2 => " (SIGINT)",
+        6 => " (SIGABRT)",
+        9 => " (SIGKILL)",
+        11 => " (SIGSEGV)",
+        15 => " (SIGTERM)",
+        _ => "",
+    }
+}
+
+/// The running node processes.
+#[derive(Debug)]
+pub struct Supervisor {
+    rt: tokio::runtime::Runtime,
+    kill: watch::Sender<bool>,
+    exits_tx: mpsc::Sender<Exit>,
+    exits: mpsc::Receiver<Exit>,
+    started: usize,
+    ended: usize,
+}
+
+impl Supervisor {
+    /// A supervisor with its own small tokio runtime.
+    pub fn new() -> std::io::Result<Self> {
+        let rt = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(1)
+            .enable_all()
+            .build()?;
+        let (kill, _) = watch::channel(false);
+        let (exits_tx, exits) = mpsc::channel();
+        Ok(Self {
+            rt,
+            kill,
+            exits_tx,
+            exits,
+            started: 0,
+            ended: 0,
+        })
+    }
+
+    /// Starts `program args…` as node `index`, stdout and stderr to `log`.
+    pub fn spawn(
+        &mut self,
+        index: usize,
+        program: &Path,
+        args: &[String],
+        log: &Path,
+    ) -> std::io::Result<()> {
+        let out = std::fs::File::create(log)?;
+        let err = out.try_clone()?;
+        let mut cmd = tokio::process::Command::new(program);
+        cmd.args(args)
+            .stdin(Stdio::null())
+            .stdout(out)
+            .stderr(err)
+            .process_group(0)
+            .kill_on_drop(true);
+        let tx = self.exits_tx.clone();
+        let mut kill = self.kill.subscribe();
+        self.started += 1;
+        let _guard = self.rt.enter();
+        let spawned = cmd.spawn();
+        self.rt.spawn(async move {
+            let mut child = match spawned {
+                Ok(c) => c,
+                Err(e) => {
+                    let _ = tx.send(Exit {
+                        index,
+                        status: Err(e.to_string()),
+                    });
+                    return;
+                }
+            };
+            let status = tokio::select! {
+                s = child.wait() => s,
+                _ = async { let _ = kill.wait_for(|k| *k).await.map(|_| ()); } => {
+                    let _ = child.start_kill();
+                    child.wait().await
+                }
+            };
+            let _ = tx.send(Exit {
+                index,
+                status: status.map_err(|e| e.to_string()),
+            });
+        });
+        Ok(())
+    }
+
+    /// An exit that happened since the last call, if any.
+    pub fn try_exit(&mut self) -> Option<Exit> {
+        let e = self.exits.try_recv().ok()?;
+        self.ended += 1;
+        Some(e)
+    }
+
+    /// Whether every started process has ended.
+    #[must_use]
+    pub fn all_ended(&self) -> bool {
+        self.ended == self.started
+    }
+
+    /// Kills every process still running (SIGKILL).
+    pub fn kill_all(&self) {
+        let _ = self.kill.send(true);
+    }
+
+    /// Waits up to `timeout` for every process to end, returning the exits;
+    /// kills the rest after that and waits for them too.
+    pub fn wait_all(&mut self, timeout: Duration) -> Vec<Exit> {
+        let mut out = Vec::new();
+        let deadline = Instant::now() + timeout;
+        while !self.all_ended() {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                self.kill_all();
+                if let Ok(e) = self.exits.recv_timeout(Duration::from_secs(5)) {
+                    self.ended += 1;
+                    out.push(e);
+                    continue;
+                }
+                break;
+            }
+            if let Ok(e) = self.exits.recv_timeout(left.min(Duration::from_millis(50))) {
+                self.ended += 1;
+                out.push(e);
+            }
+        }
+        out
+    }
+}
+
+impl Drop for Supervisor {
+    fn drop(&mut self) {
+        if !self.all_ended() {
+            self.kill_all();
+            let _ = self.wait_all(Duration::from_secs(5));
+        }
+    }
+}
+
+/// The last `n` lines of a log file (empty if unreadable).
+#[must_use]
+pub fn tail(log: &Path, n: usize) -> String {
+    let text = std::fs::read_to_string(log).unwrap_or_default();
+    let lines: Vec<&str> = text.lines().collect();
+    lines[lines.len().saturating_sub(n)..].join("\n")
+}
+
+/// Paths of the node binaries, found beside the running executable (or in
+/// `ATTSYNC_BIN_DIR`).
+pub fn find_binaries() -> Result<(PathBuf, PathBuf), String> {
+    let mut dirs = Vec::new();
+    if let Some(d) = std::env::var_os("ATTSYNC_BIN_DIR") {
+        dirs.push(PathBuf::from(d));
+    }
+    if let Ok(exe) = std::env::current_exe() {
+        if let Some(d) = exe.parent() {
+            dirs.push(d.to_owned());
+            // Test executables live in target/<profile>/deps/.
+            if let Some(p) = d.parent() {
+                dirs.push(p.to_owned());
+            }
+        }
+    }
+    for d in &dirs {
+        let (a, l) = (d.join("attsync-agent"), d.join("attsync-leader"));
+        if a.is_file() && l.is_file() {
+            return Ok((a, l));
+        }
+    }
+    Err(format!(
+        "the node binaries attsync-agent and attsync-leader are not beside attsync (looked in {}); build them with `cargo build --release --workspace` (or set ATTSYNC_BIN_DIR)",
+        dirs.iter()
+            .map(|d| d.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
+}
