@@ -22,7 +22,6 @@ use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::open::{self, OpenError};
 use msgs::{ControlCommand, ControlMsg, PROTOCOL_VERSION, StateMsg, TelemetryKind, TelemetryMsg};
-use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -62,6 +61,9 @@ pub enum NodeError {
     /// A peer broke the protocol.
     #[error("protocol violation: {0}")]
     Protocol(String),
+    /// The process that started this node has exited.
+    #[error("the orchestrator (pid {0}) has exited")]
+    Orphaned(u32),
     /// The orchestrator said stop, or the shutdown signal was raised, before the end.
     #[error("stopped before the end (at step {0})")]
     Stopped(u64),
@@ -79,6 +81,7 @@ pub fn run<S: Service, N: Stepper>(
     shutdown: &AtomicBool,
 ) -> Result<(), NodeError> {
     let (run, l, id) = (cfg.run.as_str(), &cfg.limits, cfg.id);
+    let orphan = Orphan::new();
     let stage_timeout = Duration::from_secs_f64(cfg.stage_timeout);
     let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
 
@@ -169,7 +172,7 @@ pub fn run<S: Service, N: Stepper>(
     };
     report(TelemetryMsg::bare(id, 0, TelemetryKind::Ready, 0.0))?;
     info!(id, inputs = ?cfg.inputs, outputs = ?cfg.outputs, "ready");
-    match wait_command(&control, start_timeout, shutdown)? {
+    match wait_command(&control, start_timeout, shutdown, &orphan)? {
         Some(ControlCommand::Start) => {}
         _ => return Err(NodeError::Stopped(0)),
     }
@@ -177,12 +180,14 @@ pub fn run<S: Service, N: Stepper>(
 
     // Lockstep.
     let mut waiter = Waiter::new(cfg.wait);
-    let mut queues: Vec<VecDeque<StateMsg>> = vec![VecDeque::new(); inputs.len()];
     let notify = waiter.receivers_may_block();
     report(stepper.sample(0))?;
     for n in 0..cfg.steps {
         if shutdown.load(Ordering::Relaxed) {
             return Err(NodeError::Stopped(n));
+        }
+        if n % 256 == 0 {
+            orphan.check()?;
         }
         for s in 0..4u32 {
             if cfg.coupling.exchanges_at(n, s as usize) {
@@ -198,9 +203,13 @@ pub fn run<S: Service, N: Stepper>(
                 waiter.begin();
                 for k in 0..inputs.len() {
                     let msg = loop {
-                        drain(&inputs[k], &mut queues[k])?;
-                        if let Some(m) = queues[k].pop_front() {
-                            break m;
+                        // Take one message at a time: what stays in iceoryx2's
+                        // buffer holds a fast sender back (flow control).
+                        if let Some(sample) = inputs[k].receive().map_err(port("state receive"))? {
+                            break *sample;
+                        }
+                        if waiter.polls() % 1024 == 1023 {
+                            orphan.check()?;
                         }
                         if waiter.wait(&listener, deadline) {
                             return Err(NodeError::Timeout {
@@ -229,10 +238,51 @@ pub fn run<S: Service, N: Stepper>(
         TelemetryKind::Done,
         stepper.peak_torque(),
     ))?;
-    info!(steps = cfg.steps, "done");
-    match wait_command(&control, start_timeout, shutdown)? {
+    info!(steps = cfg.steps, peak_rss_kb = peak_rss_kb(), "done");
+    // Other nodes may still be stepping: wait for Stop as long as the
+    // orchestrator lives (bounded by STOP_TIMEOUT all the same).
+    match wait_command(&control, STOP_TIMEOUT, shutdown, &orphan)? {
         Some(ControlCommand::Stop) | None => Ok(()),
         Some(ControlCommand::Start) => Err(NodeError::Protocol("second Start".into())),
+    }
+}
+
+/// Longest wait for `Stop` after the last step.
+const STOP_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// Peak resident set size of this process (VmHWM), kB; 0 if unknown.
+#[must_use]
+pub fn peak_rss_kb() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse().ok())
+        })
+        .unwrap_or(0)
+}
+
+/// Detects that the process that started us (the orchestrator) is gone, so
+/// that a node never outlives its run.
+#[derive(Debug)]
+struct Orphan {
+    parent: u32,
+}
+
+impl Orphan {
+    fn new() -> Self {
+        Self {
+            parent: std::os::unix::process::parent_id(),
+        }
+    }
+
+    fn check(&self) -> Result<(), NodeError> {
+        if std::os::unix::process::parent_id() != self.parent {
+            return Err(NodeError::Orphaned(self.parent));
+        }
+        Ok(())
     }
 }
 
@@ -250,16 +300,6 @@ fn retry_until(
             iceoryx2::port::BackpressureAction::Retry
         }
     }
-}
-
-fn drain<S: Service>(
-    sub: &Subscriber<S, StateMsg, ()>,
-    q: &mut VecDeque<StateMsg>,
-) -> Result<(), NodeError> {
-    while let Some(sample) = sub.receive().map_err(port("state receive"))? {
-        q.push_back(*sample);
-    }
-    Ok(())
 }
 
 /// The message must be from `sender`, speak our version, and carry exactly the stamp (n, s).
@@ -290,6 +330,7 @@ fn wait_command<S: Service>(
     control: &Subscriber<S, ControlMsg, ()>,
     timeout: Duration,
     shutdown: &AtomicBool,
+    orphan: &Orphan,
 ) -> Result<Option<ControlCommand>, NodeError> {
     let deadline = Instant::now() + timeout;
     loop {
@@ -306,6 +347,7 @@ fn wait_command<S: Service>(
         if shutdown.load(Ordering::Relaxed) {
             return Ok(None);
         }
+        orphan.check()?;
         if Instant::now() > deadline {
             return Err(NodeError::Timeout {
                 what: "a command from the orchestrator".into(),

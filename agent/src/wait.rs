@@ -29,6 +29,12 @@ impl Waiter {
         self.polls = 0;
     }
 
+    /// Polls in the current episode.
+    #[must_use]
+    pub fn polls(&self) -> u32 {
+        self.polls
+    }
+
     /// Whether peers using this strategy may sleep, so senders must notify.
     #[must_use]
     pub fn receivers_may_block(&self) -> bool {
