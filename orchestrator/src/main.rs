@@ -54,6 +54,17 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Convert a run's states.bin (the full state trajectory).
+    Export {
+        /// The states.bin file of a run.
+        states: PathBuf,
+        /// Write CSV (long form: one row per node per sample; node 0 is the leader).
+        #[arg(long, required = true)]
+        csv: bool,
+        /// Write here instead of stdout.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Generate a scenario.
     Gen {
         #[command(subcommand)]
@@ -172,6 +183,20 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     ExitCode::from(1)
                 }
             })
+        }
+        Command::Export {
+            states,
+            csv: _,
+            out,
+        } => {
+            let mut text = Vec::new();
+            attsync::results::states::export_csv(&states, &mut text).map_err(anyhow::Error::msg)?;
+            match out {
+                Some(path) => std::fs::write(&path, text)
+                    .with_context(|| format!("writing {}", path.display()))?,
+                None => std::io::Write::write_all(&mut std::io::stdout(), &text)?,
+            }
+            Ok(ExitCode::SUCCESS)
         }
         Command::Gen {
             what:

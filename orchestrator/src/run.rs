@@ -88,7 +88,7 @@ pub fn run(
     let dir = staging.path().to_owned();
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
     std::fs::write(dir.join("scenario.toml"), text).map_err(io_at(&dir))?;
-    let mut recorder = Recorder::new(&dir, net).map_err(io_at(&dir))?;
+    let mut recorder = Recorder::new(&dir, &loaded.name(), net).map_err(io_at(&dir))?;
 
     let bar = progress_bar(opts.progress, net.steps, net.dt);
     let started = Instant::now();

@@ -3,6 +3,7 @@
 
 pub mod plot;
 pub mod staging;
+pub mod states;
 pub mod summary;
 
 use attitude::engine::Snapshot;
@@ -37,6 +38,7 @@ pub struct Series {
 #[derive(Debug)]
 pub struct Recorder {
     csv: BufWriter<File>,
+    states: states::StatesWriter,
     dt: f64,
     has_observer: bool,
     series: Vec<Series>,
@@ -55,8 +57,9 @@ pub fn fmt_time(step: u64, dt: f64) -> String {
 }
 
 impl Recorder {
-    /// Starts `errors.csv` in `dir` for `net`.
-    pub fn new(dir: &Path, net: &Network) -> io::Result<Self> {
+    /// Starts `errors.csv` and `states.bin` in `dir` for `net`.
+    pub fn new(dir: &Path, scenario: &str, net: &Network) -> io::Result<Self> {
+        let states = states::StatesWriter::create(&dir.join("states.bin"), scenario, net)?;
         let mut csv = BufWriter::new(File::create(dir.join("errors.csv"))?);
         writeln!(csv, "{CSV_HEADER}")?;
         let has_observer = net
@@ -73,6 +76,7 @@ impl Recorder {
             .collect();
         Ok(Self {
             csv,
+            states,
             dt: net.dt,
             has_observer,
             series,
@@ -82,6 +86,7 @@ impl Recorder {
     /// Writes one row per agent for `snap`. Errors are printed with Rust's
     /// shortest round-trip formatting (full f64 precision).
     pub fn record(&mut self, snap: &Snapshot<'_>) -> io::Result<()> {
+        self.states.write(snap)?;
         let t_str = fmt_time(snap.step, self.dt);
         let t: f64 = t_str.parse().expect("fmt_time prints a number");
         for (x, s) in snap.agents.iter().zip(&mut self.series) {
@@ -108,6 +113,7 @@ impl Recorder {
     /// Flushes the CSV and returns the series.
     pub fn finish(mut self) -> io::Result<Vec<Series>> {
         self.csv.flush()?;
+        self.states.finish()?;
         Ok(self.series)
     }
 }

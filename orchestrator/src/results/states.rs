@@ -1,0 +1,257 @@
+//! `states.bin`: the full state trajectory of a run, leader and every agent
+//! at every output sample, as a bincode stream.
+//!
+//! # Layout (version 1)
+//! bincode 2, fixed-width little-endian integers
+//! (`config::standard().with_fixed_int_encoding()`): `u32`/`u64` are 4/8
+//! bytes LE, `f64` 8 bytes LE, `bool` 1 byte, a `Vec`/`String` is a `u64`
+//! length then its elements, fixed-size arrays have no length.
+//! ```text
+//! Header  { magic: [u8; 8] = "ATTSYNCS", version: u32 = 1, scenario: String,
+//!           dt: f64, sample_every: u64, agent_ids: Vec<u32>, has_observer: bool }
+//! Record* { step: u64, leader: Leader, agents: [Agent; agent_ids.len()] (as a Vec) }
+//! Leader  { r0: [f64; 9], w0: [f64; 3], s0: [f64; 3] }
+//! Agent   { r: [f64; 9], w: [f64; 3], r_hat: [f64; 9], w_hat: [f64; 3], s_hat: [f64; 3] }
+//! ```
+//! Matrices are row-major, attitudes map body to inertial, rates are in the
+//! body frame (rad/s, rad/s²); t = step · dt. Records follow until the end of
+//! the file. Both engines write identical files.
+
+use attitude::engine::Snapshot;
+use attitude::network::{AgentState, Network};
+use attitude::reference::LeaderState;
+use msgs::payload::to_rows;
+use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::io::{self, BufReader, BufWriter, Write};
+use std::path::Path;
+
+/// File magic.
+pub const MAGIC: [u8; 8] = *b"ATTSYNCS";
+/// Layout version.
+pub const VERSION: u32 = 1;
+
+fn config() -> impl bincode::config::Config {
+    bincode::config::standard().with_fixed_int_encoding()
+}
+
+/// The first value of the stream.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// [`MAGIC`].
+    pub magic: [u8; 8],
+    /// [`VERSION`].
+    pub version: u32,
+    /// Scenario name.
+    pub scenario: String,
+    /// Integrator step, s.
+    pub dt: f64,
+    /// Steps between records.
+    pub sample_every: u64,
+    /// Agent ids, in record order.
+    pub agent_ids: Vec<u32>,
+    /// Whether the observer fields are meaningful.
+    pub has_observer: bool,
+}
+
+/// The leader in a record.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LeaderRecord {
+    /// `R₀`, row-major.
+    pub r0: [f64; 9],
+    /// `ω₀`.
+    pub w0: [f64; 3],
+    /// `σ₀`.
+    pub s0: [f64; 3],
+}
+
+/// An agent in a record.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AgentRecord {
+    /// `Rᵢ`, row-major.
+    pub r: [f64; 9],
+    /// `ωᵢ`.
+    pub w: [f64; 3],
+    /// `R̂ᵢ`, row-major.
+    pub r_hat: [f64; 9],
+    /// `ω̂ᵢ`.
+    pub w_hat: [f64; 3],
+    /// `σ̂ᵢ`.
+    pub s_hat: [f64; 3],
+}
+
+/// One sample of the whole network.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Record {
+    /// Step index.
+    pub step: u64,
+    /// The leader.
+    pub leader: LeaderRecord,
+    /// The agents, in header order.
+    pub agents: Vec<AgentRecord>,
+}
+
+impl LeaderRecord {
+    fn of(l: &LeaderState) -> Self {
+        Self {
+            r0: to_rows(&l.r0),
+            w0: l.w0.into(),
+            s0: l.s0.into(),
+        }
+    }
+}
+
+impl AgentRecord {
+    fn of(x: &AgentState) -> Self {
+        Self {
+            r: to_rows(&x.r),
+            w: x.w.into(),
+            r_hat: to_rows(&x.r_hat),
+            w_hat: x.w_hat.into(),
+            s_hat: x.s_hat.into(),
+        }
+    }
+}
+
+/// Writes `states.bin` record by record.
+#[derive(Debug)]
+pub struct StatesWriter {
+    w: BufWriter<File>,
+}
+
+fn enc(e: bincode::error::EncodeError) -> io::Error {
+    io::Error::other(e.to_string())
+}
+
+impl StatesWriter {
+    /// Creates `file` and writes the header.
+    pub fn create(file: &Path, scenario: &str, net: &Network) -> io::Result<Self> {
+        let mut w = BufWriter::new(File::create(file)?);
+        let header = Header {
+            magic: MAGIC,
+            version: VERSION,
+            scenario: scenario.to_string(),
+            dt: net.dt,
+            sample_every: net.sample_every,
+            agent_ids: net.agents.iter().map(|a| a.model.id).collect(),
+            has_observer: net
+                .agents
+                .first()
+                .is_some_and(|a| a.model.scheme.has_observer()),
+        };
+        bincode::serde::encode_into_std_write(&header, &mut w, config()).map_err(enc)?;
+        Ok(Self { w })
+    }
+
+    /// Appends one snapshot.
+    pub fn write(&mut self, snap: &Snapshot<'_>) -> io::Result<()> {
+        let rec = Record {
+            step: snap.step,
+            leader: LeaderRecord::of(snap.leader),
+            agents: snap.agents.iter().map(AgentRecord::of).collect(),
+        };
+        bincode::serde::encode_into_std_write(&rec, &mut self.w, config()).map_err(enc)?;
+        Ok(())
+    }
+
+    /// Flushes the file.
+    pub fn finish(mut self) -> io::Result<()> {
+        self.w.flush()
+    }
+}
+
+/// Reads a whole `states.bin`.
+pub fn read(file: &Path) -> Result<(Header, Vec<Record>), String> {
+    let what = |e: &dyn std::fmt::Display| format!("{}: {e}", file.display());
+    let len = std::fs::metadata(file).map_err(|e| what(&e))?.len();
+    let mut r = BufReader::new(File::open(file).map_err(|e| what(&e))?);
+    let header: Header =
+        bincode::serde::decode_from_std_read(&mut r, config()).map_err(|e| what(&e))?;
+    if header.magic != MAGIC {
+        return Err(what(&"not an attsync states file (bad magic)"));
+    }
+    if header.version != VERSION {
+        return Err(what(&format!(
+            "states layout version {} (this attsync reads {VERSION})",
+            header.version
+        )));
+    }
+    let header_len = bincode::serde::encode_to_vec(&header, config())
+        .map_err(|e| what(&e))?
+        .len() as u64;
+    let record_len = 8 + 8 + 15 * 8 + header.agent_ids.len() as u64 * 27 * 8;
+    let body = len - header_len;
+    if body % record_len != 0 {
+        return Err(what(&format!(
+            "truncated: {body} bytes of records is not a multiple of the record size {record_len}"
+        )));
+    }
+    let mut records = Vec::with_capacity((body / record_len) as usize);
+    for _ in 0..body / record_len {
+        records.push(bincode::serde::decode_from_std_read(&mut r, config()).map_err(|e| what(&e))?);
+    }
+    Ok((header, records))
+}
+
+/// Converts `states.bin` to CSV, long form: one row per node per record,
+/// node 0 the leader (`r` = R₀, `w` = ω₀, `s_hat` = σ₀, observer columns empty).
+pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), String> {
+    let (h, records) = read(file)?;
+    let io = |e: io::Error| format!("writing CSV: {e}");
+    let mut cols = vec!["t".to_string(), "node".into()];
+    for name in ["r", "r_hat"] {
+        for i in 1..=3 {
+            for j in 1..=3 {
+                cols.push(format!("{name}{i}{j}"));
+            }
+        }
+    }
+    for name in ["w", "w_hat", "s_hat"] {
+        for i in 1..=3 {
+            cols.push(format!("{name}{i}"));
+        }
+    }
+    // Order: t,node,r11..r33,w1..w3,r_hat11..r_hat33,w_hat1..3,s_hat1..3
+    let order = [
+        &cols[..2],
+        &cols[2..11],
+        &cols[20..23],
+        &cols[11..20],
+        &cols[23..26],
+        &cols[26..29],
+    ]
+    .concat();
+    writeln!(out, "{}", order.join(",")).map_err(io)?;
+    let join = |v: &[f64]| {
+        v.iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(",")
+    };
+    for rec in &records {
+        let t = super::fmt_time(rec.step, h.dt);
+        writeln!(
+            out,
+            "{t},0,{},{},{},{},{}",
+            join(&rec.leader.r0),
+            join(&rec.leader.w0),
+            [""; 9].join(","),
+            [""; 3].join(","),
+            join(&rec.leader.s0)
+        )
+        .map_err(io)?;
+        for (id, a) in h.agent_ids.iter().zip(&rec.agents) {
+            writeln!(
+                out,
+                "{t},{id},{},{},{},{},{}",
+                join(&a.r),
+                join(&a.w),
+                join(&a.r_hat),
+                join(&a.w_hat),
+                join(&a.s_hat)
+            )
+            .map_err(io)?;
+        }
+    }
+    Ok(())
+}
