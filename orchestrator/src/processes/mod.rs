@@ -391,7 +391,10 @@ impl Collector {
                 }
                 match TelemetryKind::from_u32(m.kind) {
                     Some(TelemetryKind::Ready) => self.ready[i] = true,
-                    Some(TelemetryKind::Sample) => self.pending[i].push_back(m),
+                    Some(TelemetryKind::Sample) => {
+                        self.peaks[i] = self.peaks[i].max(m.peak_torque);
+                        self.pending[i].push_back(m);
+                    }
                     Some(TelemetryKind::Done) => {
                         self.done[i] = true;
                         self.peaks[i] = m.peak_torque;
