@@ -16,6 +16,7 @@ use crate::control::{
     tau_control, tau_control_constant_estimate, tau_districontrol, tracking_error,
 };
 use crate::integrate::{LieDerivative, LieState, Rkmk4};
+use crate::link::{Link, LinkModel, LinkStats};
 use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
 use crate::observer::{
     LeaderInput, omega_hat_dot_7b, omega_hat_dot_16b, r_hat_rate, sigma_hat_dot_7c,
@@ -127,6 +128,10 @@ pub struct Agent {
     dt: f64,
     held_nbrs: Vec<Exchanged>,
     held_leader: Option<Exchanged>,
+    /// Impaired links, per input (neighbours, then the leader).
+    links: Vec<Option<Link>>,
+    /// Current step index.
+    n: u64,
     peak_torque: f64,
 }
 
@@ -137,6 +142,12 @@ impl Agent {
         let gains = model.neighbours.iter().map(|n| n.a).collect();
         let held_nbrs = vec![Exchanged::identity(); model.neighbours.len()];
         let held_leader = model.leader_gain.map(|_| Exchanged::identity());
+        let impaired = |l: &Option<LinkModel>| l.filter(LinkModel::is_impaired).map(Link::new);
+        let mut links: Vec<Option<Link>> =
+            model.neighbours.iter().map(|n| impaired(&n.link)).collect();
+        if model.leader_gain.is_some() {
+            links.push(impaired(&model.leader_link));
+        }
         Self {
             model,
             gains,
@@ -145,6 +156,8 @@ impl Agent {
             dt,
             held_nbrs,
             held_leader,
+            links,
+            n: 0,
             peak_torque: 0.0,
         }
     }
@@ -174,21 +187,56 @@ impl Agent {
     }
 
     /// Stores the value received from the `k`-th neighbour (order of `model.neighbours`).
+    /// On an impaired link the message goes through the link's filter (see [`crate::link`]).
     pub fn receive_neighbour(&mut self, k: usize, x: Exchanged) {
-        self.held_nbrs[k] = x;
+        match &mut self.links[k] {
+            Some(link) => link.offer(self.n, self.step.stage() as u32, x),
+            None => self.held_nbrs[k] = x,
+        }
     }
 
     /// Stores the value received from the leader (ignored if not connected).
     pub fn receive_leader(&mut self, x: Exchanged) {
-        if let Some(h) = &mut self.held_leader {
-            *h = x;
+        let k = self.model.neighbours.len();
+        let stage = self.step.stage() as u32;
+        match (&mut self.held_leader, self.links.get_mut(k)) {
+            (Some(_), Some(Some(link))) => link.offer(self.n, stage, x),
+            (Some(h), _) => *h = x,
+            (None, _) => {}
         }
+    }
+
+    /// Counters of every impaired incoming link: (sender id, stats); the leader is 0.
+    #[must_use]
+    pub fn link_stats(&self) -> Vec<(u32, LinkStats)> {
+        let ids = self
+            .model
+            .neighbours
+            .iter()
+            .map(|n| n.id)
+            .chain(std::iter::once(0));
+        ids.zip(&self.links)
+            .filter_map(|(id, l)| l.as_ref().map(|l| (id, l.stats())))
+            .collect()
     }
 
     /// Evaluates the current stage with the held inputs and moves on.
     /// Returns `true` when a step completed.
     pub fn advance(&mut self) -> bool {
         let stage = self.step.stage();
+        let n_nbrs = self.held_nbrs.len();
+        for (k, link) in self.links.iter_mut().enumerate() {
+            if let Some(x) = link
+                .as_mut()
+                .and_then(|l| l.value_at(self.n, stage as u32, self.dt))
+            {
+                if k < n_nbrs {
+                    self.held_nbrs[k] = x;
+                } else if let Some(h) = &mut self.held_leader {
+                    *h = x;
+                }
+            }
+        }
         let x = from_lie(&self.step.stage_state());
         let (d, tau) = agent_field(
             &self.model,
@@ -204,6 +252,7 @@ impl Agent {
             Some(next) => {
                 self.state = from_lie(&next);
                 self.step = Rkmk4::new(next, self.dt);
+                self.n += 1;
                 true
             }
             None => false,

@@ -10,11 +10,12 @@
 //! - [`so3`]: hat, vex, ψ, exp, log, `Rot(θ,u)`, `|R|_I`, `dexp⁻¹`.
 //! - [`integrate`]: RKMK4 on SO(3)ⁿ × ℝ³ᵐ, driven stage by stage.
 //! - [`body`]: rigid-body dynamics (eq. `followeri`).
-//! - [`reference`]: the leader (eq. `leader`).
+//! - [`mod@reference`]: the leader (eq. `leader`).
 //! - [`observer`]: eqs. `7a`–`7c`, `16a`–`16b`.
 //! - [`control`]: eqs. `control` (corrected `sigmai`, `gammai`),
 //!   `controlconstantestimate`, `districontrol`.
 //! - [`network`]: the resolved network every engine runs.
+//! - [`link`]: delay, jitter, loss and per-link period, on the receiving side.
 //! - [`agent`]: one follower as a stage-by-stage stepper (the exchange protocol).
 //! - [`engine`]: all nodes in one process, in lockstep.
 //! - [`metrics`]: the reported errors.
@@ -26,6 +27,7 @@ pub mod checks;
 pub mod control;
 pub mod engine;
 pub mod integrate;
+pub mod link;
 pub mod metrics;
 pub mod network;
 pub mod observer;

@@ -6,6 +6,7 @@
 
 use crate::body::Inertia;
 use crate::control::ControlGains;
+use crate::link::LinkModel;
 use crate::observer::ObserverGains;
 use crate::reference::LeaderState;
 use nalgebra::{Matrix3, Vector3};
@@ -95,6 +96,9 @@ pub struct Neighbour {
     pub id: u32,
     /// `A_{i,j} = A_{j,i}` (or `Ǎ_{i,j}` for the observerless scheme).
     pub a: Matrix3<f64>,
+    /// Impairments of the link from this neighbour to the agent (`None`: ideal).
+    #[serde(default)]
+    pub link: Option<LinkModel>,
 }
 
 /// Everything agent i knows: its body, gains, neighbourhood and the shared
@@ -111,6 +115,9 @@ pub struct AgentModel {
     pub neighbours: Vec<Neighbour>,
     /// `A_{i,0}` if the agent hears the leader (`Ξᵢ = 1`).
     pub leader_gain: Option<Matrix3<f64>>,
+    /// Impairments of the link from the leader to the agent (`None`: ideal).
+    #[serde(default)]
+    pub leader_link: Option<LinkModel>,
     /// Scheme and its gains (the same for every agent).
     pub scheme: Scheme,
     /// The leader's generator `P` (known to every observer, eq. `7c`).

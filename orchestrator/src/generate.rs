@@ -164,6 +164,7 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
         leader_links,
         agents,
         edges,
+        network: Default::default(),
     };
     raise_k_sigma_until_theorem_1_holds(&mut scenario);
     Ok(scenario)

@@ -2,6 +2,7 @@
 //! everything the paper assumes before anything runs. Every problem is an
 //! [`Issue`] naming the field (TOML path, 0-based array index) and the reason.
 
+use super::schema::LossSpec;
 use super::schema::{CouplingKind, MatrixSpec, ReferenceKind, RotationSpec, Scenario, SchemeKind};
 use attitude::body::Inertia;
 use attitude::checks::{
@@ -9,6 +10,7 @@ use attitude::checks::{
     xi_plus_laplacian,
 };
 use attitude::control::ControlGains;
+use attitude::link::{LinkModel, Loss, link_seed};
 use attitude::network::{AgentModel, AgentSpec, AgentState, Coupling, Neighbour, Network, Scheme};
 use attitude::observer::ObserverGains;
 use attitude::reference::LeaderState;
@@ -669,6 +671,12 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         }
     }
 
+    let impaired = if dt > 0.0 && dt.is_finite() {
+        resolve_network(&mut c, s, dt, &edges, &link_seen)
+    } else {
+        BTreeMap::new()
+    };
+
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
@@ -687,6 +695,7 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
                         return None;
                     };
                     Some(Neighbour {
+                        link: impaired.get(&(other, id)).copied(),
                         id: other,
                         a: edge_gain[&(a, b)],
                     })
@@ -700,6 +709,7 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
                     a_bar,
                     neighbours,
                     leader_gain: links.get(&id).copied(),
+                    leader_link: impaired.get(&(0, id)).copied(),
                     scheme,
                     p,
                 },
@@ -728,6 +738,152 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         spectrum,
         appendix_d_min_eig,
     })
+}
+
+/// Impairments of every directed link (sender, receiver) that has any.
+fn resolve_network(
+    c: &mut Ctx,
+    s: &Scenario,
+    dt: f64,
+    edges: &[(u32, u32)],
+    leader_links: &BTreeMap<u32, usize>,
+) -> BTreeMap<(u32, u32), LinkModel> {
+    let net = &s.network;
+    let mut directed: BTreeSet<(u32, u32)> = BTreeSet::new();
+    for &(a, b) in edges {
+        directed.insert((a, b));
+        directed.insert((b, a));
+    }
+    for &a in leader_links.keys() {
+        directed.insert((0, a));
+    }
+    let defaults = Impairments::read(
+        c,
+        "network",
+        net.delay,
+        net.jitter,
+        net.loss.as_ref(),
+        net.period,
+        dt,
+    );
+    let mut overrides: BTreeMap<(u32, u32), (usize, Impairments)> = BTreeMap::new();
+    for (k, l) in net.links.iter().enumerate() {
+        let f = format!("network.link[{k}]");
+        if !directed.contains(&(l.from, l.to)) {
+            c.err(
+                f.clone(),
+                format!("{} → {} is not a link of this network (follower edges go both ways; the leader is 0 and only sends to its leader_link agents)", l.from, l.to),
+            );
+            continue;
+        }
+        let imp = Impairments::read(c, &f, l.delay, l.jitter, l.loss.as_ref(), l.period, dt);
+        if let Some((first, _)) = overrides.insert((l.from, l.to), (k, imp)) {
+            c.err(
+                f,
+                format!(
+                    "duplicate override of link {} → {} (also network.link[{first}])",
+                    l.from, l.to
+                ),
+            );
+        }
+    }
+    let mut out = BTreeMap::new();
+    for &(from, to) in &directed {
+        let o = overrides.get(&(from, to)).map(|(_, i)| i);
+        let pick = |f: fn(&Impairments) -> Option<u64>| o.and_then(f).or_else(|| f(&defaults));
+        let model = LinkModel {
+            delay: pick(|i| i.delay).unwrap_or(0),
+            jitter: pick(|i| i.jitter).unwrap_or(0),
+            loss: o
+                .and_then(|i| i.loss)
+                .or(defaults.loss)
+                .unwrap_or(Loss::None),
+            period: pick(|i| i.period),
+            seed: link_seed(net.seed, from, to),
+        };
+        if model.is_impaired() {
+            out.insert((from, to), model);
+        }
+    }
+    out
+}
+
+/// Impairments as read from one table, in steps.
+#[derive(Debug, Clone, Copy, Default)]
+struct Impairments {
+    delay: Option<u64>,
+    jitter: Option<u64>,
+    loss: Option<Loss>,
+    period: Option<u64>,
+}
+
+impl Impairments {
+    fn read(
+        c: &mut Ctx,
+        f: &str,
+        delay: Option<f64>,
+        jitter: Option<f64>,
+        loss: Option<&LossSpec>,
+        period: Option<f64>,
+        dt: f64,
+    ) -> Self {
+        let steps = |c: &mut Ctx, name: &str, x: Option<f64>, zero_ok: bool| -> Option<u64> {
+            let x = x?;
+            let field = format!("{f}.{name}");
+            if zero_ok && x == 0.0 {
+                return Some(0);
+            }
+            c.multiple_of_dt(&field, x, dt)
+        };
+        let prob = |c: &mut Ctx, field: String, p: f64| -> f64 {
+            if !(0.0..=1.0).contains(&p) {
+                c.err(field, format!("must be a probability in [0, 1], got {p}"));
+            }
+            p
+        };
+        let loss = loss.map(|l| match l {
+            LossSpec::Probability(p) => Loss::Bernoulli {
+                p: prob(c, format!("{f}.loss"), *p),
+            },
+            LossSpec::Model(m) => match m.model.as_str() {
+                "bernoulli" => Loss::Bernoulli {
+                    p: prob(c, format!("{f}.loss.p"), m.p.unwrap_or(0.0)),
+                },
+                "gilbert-elliott" => {
+                    let mut g =
+                        |name: &str, v: Option<f64>, default: Option<f64>| match v.or(default) {
+                            Some(v) => prob(c, format!("{f}.loss.{name}"), v),
+                            None => {
+                                c.err(
+                                    format!("{f}.loss.{name}"),
+                                    "is required by the Gilbert–Elliott model",
+                                );
+                                0.0
+                            }
+                        };
+                    Loss::GilbertElliott {
+                        p_gb: g("p_gb", m.p_gb, None),
+                        p_bg: g("p_bg", m.p_bg, None),
+                        loss_good: g("loss_good", m.loss_good, Some(0.0)),
+                        loss_bad: g("loss_bad", m.loss_bad, Some(1.0)),
+                    }
+                }
+                other => {
+                    c.err(
+                        format!("{f}.loss.model"),
+                        format!("unknown loss model {other:?} (bernoulli, gilbert-elliott)"),
+                    );
+                    Loss::None
+                }
+            },
+        });
+        Self {
+            delay: steps(c, "delay", delay, true),
+            jitter: steps(c, "jitter", jitter, true),
+            loss,
+            period: steps(c, "period", period, false),
+        }
+    }
 }
 
 /// The name of a scheme as written in scenario files.

@@ -31,6 +31,95 @@ pub struct Scenario {
     /// Undirected follower edges with their gains `A_{i,j}`.
     #[serde(default, rename = "edge")]
     pub edges: Vec<EdgeSpec>,
+    /// Communication impairments (default: an ideal network).
+    #[serde(default)]
+    pub network: NetworkSpec,
+}
+
+/// `[network]`: impairments of every link (defaults) and per directed link
+/// (`[[network.link]]`), acting on the receiving side in simulated time.
+/// Delay, jitter and period are whole multiples of `simulation.dt`.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NetworkSpec {
+    /// Seed of the loss and jitter streams.
+    #[serde(default)]
+    pub seed: u64,
+    /// Constant delay of every message, s.
+    #[serde(default)]
+    pub delay: Option<f64>,
+    /// Extra delay uniform in [0, jitter], s.
+    #[serde(default)]
+    pub jitter: Option<f64>,
+    /// Loss: a probability (Bernoulli) or a loss model table.
+    #[serde(default)]
+    pub loss: Option<LossSpec>,
+    /// Exchange period of every link, s (the link then carries only stage-0
+    /// messages of every period).
+    #[serde(default)]
+    pub period: Option<f64>,
+    /// Per-link overrides.
+    #[serde(default, rename = "link")]
+    pub links: Vec<LinkSpec>,
+}
+
+/// `[[network.link]]`: one directed link's impairments (unset fields take
+/// the `[network]` defaults).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinkSpec {
+    /// Sender id (0 = leader).
+    pub from: u32,
+    /// Receiver id.
+    pub to: u32,
+    /// Constant delay, s.
+    #[serde(default)]
+    pub delay: Option<f64>,
+    /// Jitter bound, s.
+    #[serde(default)]
+    pub jitter: Option<f64>,
+    /// Loss.
+    #[serde(default)]
+    pub loss: Option<LossSpec>,
+    /// Exchange period, s.
+    #[serde(default)]
+    pub period: Option<f64>,
+}
+
+/// `loss = 0.1` (Bernoulli) or `loss = { model = "gilbert-elliott", p_gb, p_bg, loss_good, loss_bad }`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a probability, or a table { model = \"gilbert-elliott\", p_gb, p_bg, loss_good, loss_bad }"
+)]
+pub enum LossSpec {
+    /// Bernoulli loss probability.
+    Probability(f64),
+    /// A loss model.
+    Model(LossModelSpec),
+}
+
+/// A loss model table.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LossModelSpec {
+    /// `"bernoulli"` or `"gilbert-elliott"`.
+    pub model: String,
+    /// Bernoulli probability.
+    #[serde(default)]
+    pub p: Option<f64>,
+    /// Gilbert–Elliott P(good → bad) per message.
+    #[serde(default)]
+    pub p_gb: Option<f64>,
+    /// Gilbert–Elliott P(bad → good) per message.
+    #[serde(default)]
+    pub p_bg: Option<f64>,
+    /// Loss probability in the good state (default 0).
+    #[serde(default)]
+    pub loss_good: Option<f64>,
+    /// Loss probability in the bad state (default 1).
+    #[serde(default)]
+    pub loss_bad: Option<f64>,
 }
 
 /// `[simulation]`.

@@ -1,0 +1,220 @@
+//! Communication impairments of one directed link (sender → receiver),
+//! applied on the receiving side, in simulated time, inside lockstep.
+//!
+//! # Semantics
+//! Time is counted in **exchange slots** `(n, s)`: step n, RKMK4 stage s.
+//! Every message a sender publishes is stamped with its slot. On an impaired
+//! link a message stamped `(m, s)`:
+//! - is dropped with the link's loss model (Bernoulli, or Gilbert–Elliott
+//!   bursts), drawn from a per-link pseudo-random stream seeded by
+//!   `(seed, from, to)` and advanced once per message in stamp order;
+//! - otherwise is delivered at slot `(m + d, s)` with `d = delay + J` steps,
+//!   `J` uniform in `0..=jitter` (whole steps);
+//! - a link with an exchange `period` of p steps carries only the messages
+//!   stamped `(m, 0)` with `m % p == 0`.
+//!
+//! At every slot the receiver holds the freshest delivered message (largest
+//! stamp); a late, older message never replaces a newer one, and a lost
+//! message means the receiver keeps what it had. Before the first delivery
+//! the receiver holds the sender's state at t = 0 (the history of a delayed
+//! system before t = 0 is its initial state). With a constant delay of k
+//! steps the receiver uses at stage s of step n exactly the sender's stage-s
+//! state of step n − k: RK4 applied to the delay equation by the method of
+//! steps.
+//!
+//! A link without impairments is not filtered at all, so an unimpaired run
+//! stays byte-identical to the plain engine.
+
+use crate::network::Exchanged;
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+
+/// A message's loss process.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Loss {
+    /// Nothing is lost.
+    None,
+    /// Each message is lost independently with probability `p`.
+    Bernoulli {
+        /// Loss probability in [0, 1].
+        p: f64,
+    },
+    /// Two-state Markov chain (good/bad), advanced once per message.
+    GilbertElliott {
+        /// P(good → bad) per message.
+        p_gb: f64,
+        /// P(bad → good) per message.
+        p_bg: f64,
+        /// Loss probability in the good state.
+        loss_good: f64,
+        /// Loss probability in the bad state.
+        loss_bad: f64,
+    },
+}
+
+/// Impairments of one directed link, in whole steps.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LinkModel {
+    /// Constant delay, steps.
+    pub delay: u64,
+    /// Largest extra delay, steps (uniform in `0..=jitter`).
+    pub jitter: u64,
+    /// Loss process.
+    pub loss: Loss,
+    /// Exchange period of this link, steps (`None`: every exchange).
+    pub period: Option<u64>,
+    /// Seed of the link's random stream (already mixed with the link's ends).
+    pub seed: u64,
+}
+
+impl LinkModel {
+    /// Whether the link changes anything.
+    #[must_use]
+    pub fn is_impaired(&self) -> bool {
+        self.delay > 0 || self.jitter > 0 || self.loss != Loss::None || self.period.is_some()
+    }
+}
+
+/// SplitMix64: a small, well-mixed, seedable stream (Steele et al. 2014).
+#[derive(Debug, Clone)]
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// Mixes a scenario seed with a link's ends into the link's seed.
+#[must_use]
+pub fn link_seed(seed: u64, from: u32, to: u32) -> u64 {
+    let mut s = SplitMix64(seed ^ (u64::from(from) << 32 | u64::from(to)).rotate_left(17));
+    s.next()
+}
+
+/// Counters of one link, for the results.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct LinkStats {
+    /// Messages the sender offered on this link.
+    pub sent: u64,
+    /// Messages delivered to the receiver.
+    pub delivered: u64,
+    /// Messages lost.
+    pub lost: u64,
+    /// Sum of the age of information over evaluated stages, s
+    /// (age = receiver stage time − send time of the held value).
+    pub age_sum: f64,
+    /// Largest age of information, s.
+    pub age_max: f64,
+    /// Stages evaluated.
+    pub evaluations: u64,
+}
+
+/// Stage time as a fraction of a step.
+const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
+
+/// The receiving end of an impaired link.
+#[derive(Debug, Clone)]
+pub struct Link {
+    model: LinkModel,
+    rng: SplitMix64,
+    bad: bool,
+    /// Not yet delivered: (deliver step, step, stage, value).
+    inflight: VecDeque<(u64, u64, u32, Exchanged)>,
+    held: Option<(u64, u32, Exchanged)>,
+    stats: LinkStats,
+}
+
+impl Link {
+    /// A link with `model`.
+    #[must_use]
+    pub fn new(model: LinkModel) -> Self {
+        Self {
+            rng: SplitMix64(model.seed),
+            model,
+            bad: false,
+            inflight: VecDeque::new(),
+            held: None,
+            stats: LinkStats::default(),
+        }
+    }
+
+    /// Offers the sender's message stamped `(m, s)`.
+    pub fn offer(&mut self, m: u64, s: u32, x: Exchanged) {
+        if self.held.is_none() {
+            // History before t = 0: the sender's initial state.
+            self.held = Some((0, 0, x));
+        }
+        if let Some(p) = self.model.period {
+            if s != 0 || m % p != 0 {
+                return;
+            }
+        }
+        self.stats.sent += 1;
+        let lost = match self.model.loss {
+            Loss::None => false,
+            Loss::Bernoulli { p } => self.rng.unit() < p,
+            Loss::GilbertElliott {
+                p_gb,
+                p_bg,
+                loss_good,
+                loss_bad,
+            } => {
+                let flip = self.rng.unit();
+                self.bad = if self.bad { flip >= p_bg } else { flip < p_gb };
+                self.rng.unit() < if self.bad { loss_bad } else { loss_good }
+            }
+        };
+        if lost {
+            self.stats.lost += 1;
+            return;
+        }
+        let jitter = if self.model.jitter > 0 {
+            self.rng.next() % (self.model.jitter + 1)
+        } else {
+            0
+        };
+        self.inflight
+            .push_back((m + self.model.delay + jitter, m, s, x));
+    }
+
+    /// The value the receiver uses at slot `(n, s)`; `dt` converts ages to seconds.
+    pub fn value_at(&mut self, n: u64, s: u32, dt: f64) -> Option<Exchanged> {
+        let mut k = 0;
+        while k < self.inflight.len() {
+            let (at, m, ms, x) = self.inflight[k];
+            if (at, ms) <= (n, s) {
+                self.inflight.remove(k);
+                self.stats.delivered += 1;
+                let fresher = self.held.is_none_or(|(hm, hs, _)| (m, ms) >= (hm, hs));
+                if fresher {
+                    self.held = Some((m, ms, x));
+                }
+            } else {
+                k += 1;
+            }
+        }
+        let (hm, hs, x) = self.held?;
+        let age = ((n as f64 + C[s as usize]) - (hm as f64 + C[hs as usize])) * dt;
+        self.stats.age_sum += age;
+        self.stats.age_max = self.stats.age_max.max(age);
+        self.stats.evaluations += 1;
+        Some(x)
+    }
+
+    /// The link's counters.
+    #[must_use]
+    pub fn stats(&self) -> LinkStats {
+        self.stats
+    }
+}
