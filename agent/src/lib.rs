@@ -66,6 +66,10 @@ impl Stepper for AgentNode {
     fn peak_torque(&self) -> f64 {
         self.agent.peak_torque()
     }
+
+    fn link_stats(&self) -> Vec<(u32, attitude::link::LinkStats)> {
+        self.agent.link_stats()
+    }
 }
 
 /// Runs the agent of `cfg` on `node` until the end of the protocol.

@@ -18,6 +18,7 @@ use crate::wait::Waiter;
 use attitude::network::Exchanged;
 use iceoryx2::node::Node;
 use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::open::{self, OpenError};
@@ -39,6 +40,10 @@ pub trait Stepper {
     fn sample(&self, step: u64) -> TelemetryMsg;
     /// Largest torque norm so far.
     fn peak_torque(&self) -> f64;
+    /// Counters of the impaired incoming links: (sender id, stats).
+    fn link_stats(&self) -> Vec<(u32, attitude::link::LinkStats)> {
+        Vec::new()
+    }
 }
 
 /// Why a node stopped before completing the protocol.
@@ -148,6 +153,14 @@ pub fn run<S: Service, N: Stepper>(
             .filter(|(_, s)| s.dynamic_config().number_of_publishers() < 1)
             .map(|(&j, _)| j)
             .collect();
+        if missing.is_empty() {
+            // iceoryx2 attaches a subscriber to a publisher lazily; attach
+            // now, so that nothing a sender publishes before our first
+            // receive() can be dropped.
+            for sub in &inputs {
+                sub.update_connections().map_err(port("connect input"))?;
+            }
+        }
         if subs_ok && missing.is_empty() {
             break;
         }
@@ -231,6 +244,9 @@ pub fn run<S: Service, N: Stepper>(
         if done % cfg.sample_every == 0 || done == cfg.steps {
             report(stepper.sample(done))?;
         }
+    }
+    for (from, st) in stepper.link_stats() {
+        report(TelemetryMsg::link_stats(id, from, &st))?;
     }
     report(TelemetryMsg::bare(
         id,

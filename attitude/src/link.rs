@@ -27,7 +27,8 @@
 
 use crate::network::Exchanged;
 use serde::{Deserialize, Serialize};
-use std::collections::VecDeque;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 
 /// A message's loss process.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -120,6 +121,34 @@ pub struct LinkStats {
     pub evaluations: u64,
 }
 
+/// A message on its way: delivery slot, stamp, value (ordered by slot, then stamp).
+#[derive(Debug, Clone, Copy)]
+struct InFlight {
+    at: (u64, u32),
+    stamp: (u64, u32),
+    x: Exchanged,
+}
+
+impl PartialEq for InFlight {
+    fn eq(&self, o: &Self) -> bool {
+        (self.at, self.stamp) == (o.at, o.stamp)
+    }
+}
+
+impl Eq for InFlight {}
+
+impl PartialOrd for InFlight {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+impl Ord for InFlight {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        (self.at, self.stamp).cmp(&(o.at, o.stamp))
+    }
+}
+
 /// Stage time as a fraction of a step.
 const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
 
@@ -129,8 +158,8 @@ pub struct Link {
     model: LinkModel,
     rng: SplitMix64,
     bad: bool,
-    /// Not yet delivered: (deliver step, step, stage, value).
-    inflight: VecDeque<(u64, u64, u32, Exchanged)>,
+    /// Not yet delivered, earliest delivery first.
+    inflight: BinaryHeap<Reverse<InFlight>>,
     held: Option<(u64, u32, Exchanged)>,
     stats: LinkStats,
 }
@@ -143,7 +172,7 @@ impl Link {
             rng: SplitMix64(model.seed),
             model,
             bad: false,
-            inflight: VecDeque::new(),
+            inflight: BinaryHeap::new(),
             held: None,
             stats: LinkStats::default(),
         }
@@ -184,24 +213,21 @@ impl Link {
         } else {
             0
         };
-        self.inflight
-            .push_back((m + self.model.delay + jitter, m, s, x));
+        self.inflight.push(Reverse(InFlight {
+            at: (m + self.model.delay + jitter, s),
+            stamp: (m, s),
+            x,
+        }));
     }
 
     /// The value the receiver uses at slot `(n, s)`; `dt` converts ages to seconds.
     pub fn value_at(&mut self, n: u64, s: u32, dt: f64) -> Option<Exchanged> {
-        let mut k = 0;
-        while k < self.inflight.len() {
-            let (at, m, ms, x) = self.inflight[k];
-            if (at, ms) <= (n, s) {
-                self.inflight.remove(k);
-                self.stats.delivered += 1;
-                let fresher = self.held.is_none_or(|(hm, hs, _)| (m, ms) >= (hm, hs));
-                if fresher {
-                    self.held = Some((m, ms, x));
-                }
-            } else {
-                k += 1;
+        while self.inflight.peek().is_some_and(|f| f.0.at <= (n, s)) {
+            let Reverse(f) = self.inflight.pop().expect("peeked");
+            self.stats.delivered += 1;
+            let (m, ms) = f.stamp;
+            if self.held.is_none_or(|(hm, hs, _)| (m, ms) >= (hm, hs)) {
+                self.held = Some((m, ms, f.x));
             }
         }
         let (hm, hs, x) = self.held?;

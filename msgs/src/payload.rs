@@ -87,6 +87,10 @@ pub enum TelemetryKind {
     Sample = 2,
     /// The node has done its last step; `peak_torque` is final.
     Done = 3,
+    /// Counters of one incoming link, sent before `Done`: `step` = the
+    /// sender's id, `w` = [sent, delivered, lost], `w_hat` = [sum of the age
+    /// of information over evaluated stages (s), largest age (s), stages evaluated].
+    LinkStats = 4,
 }
 
 impl TelemetryKind {
@@ -97,6 +101,7 @@ impl TelemetryKind {
             1 => Some(Self::Ready),
             2 => Some(Self::Sample),
             3 => Some(Self::Done),
+            4 => Some(Self::LinkStats),
             _ => None,
         }
     }
@@ -176,6 +181,32 @@ impl TelemetryMsg {
             s_hat: x.s0.into(),
             ..Self::bare(0, step, TelemetryKind::Sample, 0.0)
         }
+    }
+
+    /// Counters of the link `from` → `sender`.
+    #[must_use]
+    pub fn link_stats(sender: u32, from: u32, s: &attitude::link::LinkStats) -> Self {
+        Self {
+            w: [s.sent as f64, s.delivered as f64, s.lost as f64],
+            w_hat: [s.age_sum, s.age_max, s.evaluations as f64],
+            ..Self::bare(sender, u64::from(from), TelemetryKind::LinkStats, 0.0)
+        }
+    }
+
+    /// Decodes link counters: (from, stats).
+    #[must_use]
+    pub fn decode_link_stats(&self) -> (u32, attitude::link::LinkStats) {
+        (
+            self.step as u32,
+            attitude::link::LinkStats {
+                sent: self.w[0] as u64,
+                delivered: self.w[1] as u64,
+                lost: self.w[2] as u64,
+                age_sum: self.w_hat[0],
+                age_max: self.w_hat[1],
+                evaluations: self.w_hat[2] as u64,
+            },
+        )
     }
 
     /// Decodes an agent's state.

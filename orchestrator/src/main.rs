@@ -54,6 +54,45 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Run a scenario for each value of one field (in parallel), and optionally
+    /// bisect for the largest value that still converges.
+    Sweep {
+        /// Scenario file (TOML).
+        scenario: PathBuf,
+        /// Field to sweep, as for --set (e.g. network.delay, network.loss, scheme.control.k_r).
+        #[arg(long)]
+        param: String,
+        /// Values, comma-separated (TOML literals).
+        #[arg(long, value_delimiter = ',', required = true)]
+        values: Vec<String>,
+        /// Runs at once [default: number of cores].
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Engine of every run.
+        #[arg(long, value_enum, default_value_t = Engine::Processes)]
+        engine: Engine,
+        /// How node processes wait for their inputs (processes engine).
+        #[arg(long, value_enum, default_value_t = WaitArg::Adaptive)]
+        wait: WaitArg,
+        /// Override a field of every run: key.path=value (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Sweep directory [default: results/<scenario name>-sweep-<param>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Converged: complete, and every agent's final attitude error below this.
+        #[arg(long, default_value_t = 1e-3)]
+        tolerance: f64,
+        /// Bisect between the first value (must converge) and the last (must not).
+        #[arg(long)]
+        find_margin: bool,
+        /// Bisection iterations.
+        #[arg(long, default_value_t = 8)]
+        bisect: u32,
+        /// Round bisection points to multiples of this [default: simulation.dt for delays, jitters and periods, else none].
+        #[arg(long)]
+        quantum: Option<f64>,
+    },
     /// Convert a run's states.bin (the full state trajectory).
     Export {
         /// The states.bin file of a run.
@@ -109,6 +148,17 @@ enum WaitArg {
     Adaptive,
 }
 
+impl From<WaitArg> for WaitStrategy {
+    fn from(w: WaitArg) -> Self {
+        match w {
+            WaitArg::Spin => WaitStrategy::Spin,
+            WaitArg::Yield => WaitStrategy::Yield,
+            WaitArg::Block => WaitStrategy::Block,
+            WaitArg::Adaptive => WaitStrategy::Adaptive,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum SchemeArg {
     ObserverTimeVarying,
@@ -156,12 +206,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             let flag = interrupt.clone();
             ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
                 .context("installing the Ctrl-C handler")?;
-            let wait = match wait {
-                WaitArg::Spin => WaitStrategy::Spin,
-                WaitArg::Yield => WaitStrategy::Yield,
-                WaitArg::Block => WaitStrategy::Block,
-                WaitArg::Adaptive => WaitStrategy::Adaptive,
-            };
+            let wait = wait.into();
             let opts = RunOptions {
                 engine,
                 out: out.clone(),
@@ -183,6 +228,64 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                     ExitCode::from(1)
                 }
             })
+        }
+        Command::Sweep {
+            scenario,
+            param,
+            values,
+            jobs,
+            engine,
+            wait,
+            set,
+            out,
+            tolerance,
+            find_margin,
+            bisect,
+            quantum,
+        } => {
+            let loaded = scenario::load(&scenario, &set)?;
+            let out = out.unwrap_or_else(|| {
+                PathBuf::from("results").join(format!(
+                    "{}-sweep-{}",
+                    loaded.name(),
+                    param.replace(['.', '[', ']'], "_")
+                ))
+            });
+            let timing = ["delay", "jitter", "period"]
+                .iter()
+                .any(|k| param.ends_with(k));
+            let quantum = quantum.unwrap_or(if timing {
+                loaded.resolved.network.dt
+            } else {
+                0.0
+            });
+            let interrupt = Arc::new(AtomicBool::new(false));
+            let flag = interrupt.clone();
+            ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed))
+                .context("installing the Ctrl-C handler")?;
+            let o = attsync::sweep::SweepOptions {
+                scenario,
+                param: param.clone(),
+                values,
+                jobs: jobs
+                    .unwrap_or_else(|| std::thread::available_parallelism().map_or(2, |n| n.get())),
+                set,
+                run: RunOptions {
+                    engine,
+                    out: out.clone(),
+                    processes: ProcessOptions {
+                        wait: wait.into(),
+                        ..ProcessOptions::default()
+                    },
+                    progress: false,
+                },
+                tolerance,
+                find_margin: find_margin.then_some((bisect, quantum)),
+            };
+            let r = attsync::sweep::sweep(&o, &interrupt).map_err(anyhow::Error::msg)?;
+            print!("{}", attsync::sweep::table(&param, &r));
+            println!("results: {}", out.display());
+            Ok(ExitCode::SUCCESS)
         }
         Command::Export {
             states,

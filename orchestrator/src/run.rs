@@ -101,7 +101,7 @@ pub fn run(
         bar.set_position(snap.step);
         true
     };
-    let (peaks, steps, failure) = match opts.engine {
+    let (peaks, steps, failure, links) = match opts.engine {
         Engine::InProcess => {
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
@@ -113,15 +113,27 @@ pub fn run(
                 record(snap)
             });
             let peaks = engine.agents().iter().map(|a| a.peak_torque()).collect();
+            let mut links: Vec<(u32, u32, attitude::link::LinkStats)> = engine
+                .agents()
+                .iter()
+                .flat_map(|a| {
+                    let to = a.model().id;
+                    a.link_stats()
+                        .into_iter()
+                        .map(move |(from, st)| (from, to, st))
+                })
+                .collect();
+            links.sort_by_key(|&(f, t, _)| (f, t));
             (
                 peaks,
                 engine.step_index(),
                 interrupted.then(|| "interrupted".to_string()),
+                links,
             )
         }
         Engine::Processes => {
             let out = processes::run(net, &opts.processes, &dir.join("logs"), interrupt, record)?;
-            (out.peak_torques, out.steps, out.failure)
+            (out.peak_torques, out.steps, out.failure, out.links)
         }
     };
     let wall_seconds = started.elapsed().as_secs_f64();
@@ -144,6 +156,22 @@ pub fn run(
         wall_seconds,
         max_final_att_err: agents.iter().map(|a| a.final_att_err).fold(0.0, f64::max),
         agents,
+        links: links
+            .iter()
+            .map(|(from, to, st)| results::summary::LinkSummary {
+                from: *from,
+                to: *to,
+                sent: st.sent,
+                delivered: st.delivered,
+                lost: st.lost,
+                aoi_mean: if st.evaluations > 0 {
+                    st.age_sum / st.evaluations as f64
+                } else {
+                    0.0
+                },
+                aoi_max: st.age_max,
+            })
+            .collect(),
     };
     let svg = dir.join("errors.svg");
     plot::draw(

@@ -8,6 +8,7 @@ pub mod namespace;
 pub mod supervise;
 
 use attitude::engine::Snapshot;
+use attitude::link::LinkStats;
 use attitude::network::{AgentState, Network};
 use attitude::reference::LeaderState;
 use iceoryx2::node::NodeBuilder;
@@ -72,6 +73,8 @@ pub struct Outcome {
     pub steps: u64,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
+    /// Counters of the impaired links: (from, to, stats).
+    pub links: Vec<(u32, u32, LinkStats)>,
 }
 
 fn iox<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ProcessError {
@@ -224,6 +227,7 @@ pub fn run(
         done: vec![false; n_nodes],
         peaks: vec![0.0; n_nodes],
         steps: 0,
+        links: Vec::new(),
     };
     let failure = (|| -> Option<String> {
         // Phase 1: every node ready.
@@ -314,6 +318,7 @@ pub fn run(
             if !bad.is_empty() {
                 return Ok(Outcome {
                     peak_torques: c.peaks[1..].to_vec(),
+                    links: std::mem::take(&mut c.links),
                     steps: c.steps,
                     failure: Some(format!("nodes failed at shutdown: {}", bad.join("; "))),
                 });
@@ -329,8 +334,10 @@ pub fn run(
     drop(listener);
     drop(node);
     drop(ns);
+    c.links.sort_by_key(|&(f, t, _)| (f, t));
     Ok(Outcome {
         peak_torques: c.peaks[1..].to_vec(),
+        links: c.links,
         steps: c.steps,
         failure,
     })
@@ -348,10 +355,10 @@ fn check_exits(
         let clean = matches!(&e.status, Ok(s) if s.success());
         if !(done[e.index] && clean) {
             return Some(format!(
-                "{} ended during the run ({}); last lines of {}:\n{}",
+                "{} ended during the run ({}); last lines of its log (logs/{}.log in the results directory):\n{}",
                 node_name(net, e.index),
                 describe(&e.status),
-                log_of(e.index).display(),
+                node_name(net, e.index),
                 tail(&log_of(e.index), 10)
             ));
         }
@@ -366,6 +373,7 @@ struct Collector {
     done: Vec<bool>,
     peaks: Vec<f64>,
     steps: u64,
+    links: Vec<(u32, u32, LinkStats)>,
 }
 
 impl Collector {
@@ -394,6 +402,10 @@ impl Collector {
                     Some(TelemetryKind::Sample) => {
                         self.peaks[i] = self.peaks[i].max(m.peak_torque);
                         self.pending[i].push_back(m);
+                    }
+                    Some(TelemetryKind::LinkStats) => {
+                        let (from, st) = m.decode_link_stats();
+                        self.links.push((from, m.sender, st));
                     }
                     Some(TelemetryKind::Done) => {
                         self.done[i] = true;

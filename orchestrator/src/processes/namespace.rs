@@ -38,9 +38,16 @@ impl Namespace {
             COUNTER.fetch_add(1, Ordering::Relaxed),
             nanos & 0xffff
         );
-        let dir = base_dir().join(&run);
-        fs::create_dir_all(&dir)?;
-        fs::write(dir.join("owner"), std::process::id().to_string())?;
+        // Build the directory with its owner file under a hidden name and
+        // rename it into place, so that another attsync's stale-namespace
+        // sweep never sees a namespace without an owner.
+        let base = base_dir();
+        fs::create_dir_all(&base)?;
+        let tmp = base.join(format!(".{run}.creating"));
+        fs::create_dir_all(&tmp)?;
+        fs::write(tmp.join("owner"), std::process::id().to_string())?;
+        let dir = base.join(&run);
+        fs::rename(&tmp, &dir)?;
         Ok(Self { run, dir })
     }
 
@@ -100,8 +107,21 @@ pub fn remove_stale() {
         return;
     };
     for e in rd.filter_map(Result::ok) {
-        let run = e.file_name().to_string_lossy().into_owned();
+        let name = e.file_name().to_string_lossy().into_owned();
         let owner = fs::read_to_string(e.path().join("owner")).ok();
+        if let Some(creating) = name.strip_prefix('.') {
+            // A namespace being created: leave it unless its creator is dead.
+            let dead = owner
+                .as_deref()
+                .and_then(|p| p.trim().parse::<u32>().ok())
+                .is_some_and(|pid| !Path::new(&format!("/proc/{pid}")).exists());
+            if dead {
+                let _ = fs::remove_dir_all(e.path());
+            }
+            let _ = creating;
+            continue;
+        }
+        let run = name;
         let alive = owner
             .and_then(|p| p.trim().parse::<u32>().ok())
             .is_some_and(|pid| Path::new(&format!("/proc/{pid}")).exists());

@@ -26,6 +26,26 @@ pub struct AgentSummary {
     pub peak_torque: f64,
 }
 
+/// Counters of one impaired directed link (links without impairments are
+/// ideal in lockstep and not listed).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LinkSummary {
+    /// Sender id (0 = leader).
+    pub from: u32,
+    /// Receiver id.
+    pub to: u32,
+    /// Messages offered on the link.
+    pub sent: u64,
+    /// Messages delivered.
+    pub delivered: u64,
+    /// Messages lost.
+    pub lost: u64,
+    /// Mean age of information of the value the receiver used, over its stages, s.
+    pub aoi_mean: f64,
+    /// Largest age of information, s.
+    pub aoi_max: f64,
+}
+
 /// The whole run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
@@ -53,6 +73,8 @@ pub struct Summary {
     pub max_final_att_err: f64,
     /// Per agent, ascending id.
     pub agents: Vec<AgentSummary>,
+    /// Per impaired link, by (from, to).
+    pub links: Vec<LinkSummary>,
 }
 
 /// Time after which `err` stays below `threshold`: the sample after the last

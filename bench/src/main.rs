@@ -1,0 +1,251 @@
+//! `attsync-bench`: the benchmark of attsync's engines against a bare
+//! iceoryx2 lockstep ring (results in BENCHMARKS.md).
+//!
+//! ```sh
+//! cargo build --release --workspace
+//! ./target/release/attsync-bench run --out bench-results.md       # full, ~10–15 min on 2 cores
+//! ./target/release/attsync-bench run --quick --out quick.md       # ~2 min, one repetition
+//! ./target/release/attsync-bench run --only tree-32 --reps 1      # one case
+//! ```
+//! It needs `attsync`, `attsync-agent` and `attsync-leader` beside it (or
+//! `--bin-dir`), and the paper scenarios (`--scenarios`, default
+//! `scenarios/paper` of this workspace). Run it on an otherwise idle
+//! machine: before each measurement it waits (up to `--idle-wait` seconds,
+//! default 20) for other processes to leave the CPUs idle, and the report's
+//! "bg load" column shows how much other work ran during the measurements.
+//!
+//! `attsync-bench ring-node …` is internal: one process of the bare ring,
+//! started by `run` (see [`ring`]).
+//!
+//! The benchmark is not part of `cargo test` (its unit tests check parsing
+//! and statistics only; nothing is timed).
+
+mod measure;
+mod procs;
+mod ring;
+mod stats;
+mod suite;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use msgs::config::WaitStrategy;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Benchmark of attsync: in-process engine, process engine per wait strategy, bare iceoryx2 ring.
+#[derive(Debug, Parser)]
+#[command(name = "attsync-bench", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Debug, Subcommand)]
+enum Cmd {
+    /// Run the whole benchmark and print a Markdown report.
+    Run {
+        /// Shorter runs (paper scenarios 10 s, trees 0.5 / 0.25 s) and one repetition.
+        #[arg(long)]
+        quick: bool,
+        /// Also write the report to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Repetitions per measurement (default 3, 1 with --quick).
+        #[arg(long)]
+        reps: Option<usize>,
+        /// Only cases whose label contains this (repeatable): paper-timevarying, tree-32, …
+        #[arg(long)]
+        only: Vec<String>,
+        /// Only this wait strategy (repeatable; default: all four).
+        #[arg(long, value_enum)]
+        wait: Vec<WaitArg>,
+        /// Directory of the paper scenarios.
+        #[arg(long)]
+        scenarios: Option<PathBuf>,
+        /// Directory of attsync, attsync-agent, attsync-leader (default: beside this program).
+        #[arg(long)]
+        bin_dir: Option<PathBuf>,
+        /// Scratch directory (default: `<tmp>/attsync-bench-<pid>`, removed at the end).
+        #[arg(long)]
+        work: Option<PathBuf>,
+        /// Before each measurement, wait up to this many seconds for other
+        /// processes to leave the CPUs idle (0: don't wait).
+        #[arg(long, default_value_t = 20)]
+        idle_wait: u64,
+    },
+    /// (internal) One process of the bare iceoryx2 lockstep ring.
+    RingNode {
+        /// Run id (iceoryx2 namespace).
+        #[arg(long)]
+        run: String,
+        /// Run directory (iceoryx2 root ROOT/iox, barrier files).
+        #[arg(long)]
+        root: PathBuf,
+        /// This node's id.
+        #[arg(long)]
+        index: u32,
+        /// Number of nodes.
+        #[arg(long)]
+        n: u32,
+        /// Steps (4 exchanges each).
+        #[arg(long)]
+        steps: u64,
+        /// Wait strategy.
+        #[arg(long, value_enum)]
+        wait: WaitArg,
+        /// Input ids, comma-separated (default: the ring neighbours; may be empty).
+        #[arg(long)]
+        inputs: Option<String>,
+        /// Receiver ids, comma-separated (default: the ring neighbours).
+        #[arg(long)]
+        outputs: Option<String>,
+        /// Fan-out limit of the services (default 2, the ring's).
+        #[arg(long, default_value_t = 2)]
+        max_fanout: usize,
+        /// Longest wait for one exchange's inputs, s.
+        #[arg(long, default_value_t = 10.0)]
+        stage_timeout: f64,
+        /// Longest wait at each barrier, s.
+        #[arg(long, default_value_t = 120.0)]
+        barrier_timeout: f64,
+    },
+}
+
+/// Wait strategies (as `attsync run --wait`).
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum WaitArg {
+    /// Busy-poll.
+    Spin,
+    /// Poll with sched_yield.
+    Yield,
+    /// Sleep on iceoryx2 events (1 ms slices).
+    Block,
+    /// Yield a while, then block.
+    Adaptive,
+}
+
+impl From<WaitArg> for WaitStrategy {
+    fn from(w: WaitArg) -> Self {
+        match w {
+            WaitArg::Spin => Self::Spin,
+            WaitArg::Yield => Self::Yield,
+            WaitArg::Block => Self::Block,
+            WaitArg::Adaptive => Self::Adaptive,
+        }
+    }
+}
+
+fn id_list(s: Option<String>) -> Result<Option<Vec<u32>>, String> {
+    s.map(|s| {
+        s.split(',')
+            .filter(|x| !x.trim().is_empty())
+            .map(|x| x.trim().parse().map_err(|e| format!("node id {x:?}: {e}")))
+            .collect()
+    })
+    .transpose()
+}
+
+fn main() -> ExitCode {
+    match dispatch(Cli::parse().command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("attsync-bench: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn dispatch(cmd: Cmd) -> Result<(), String> {
+    match cmd {
+        Cmd::RingNode {
+            run,
+            root,
+            index,
+            n,
+            steps,
+            wait,
+            inputs,
+            outputs,
+            max_fanout,
+            stage_timeout,
+            barrier_timeout,
+        } => {
+            let node = ring::RingNode {
+                run,
+                root,
+                index,
+                n,
+                steps,
+                wait: wait.into(),
+                inputs: id_list(inputs)?,
+                outputs: id_list(outputs)?,
+                max_fanout,
+                stage_timeout,
+                barrier_timeout,
+            };
+            println!("{}", node.run()?.line());
+            Ok(())
+        }
+        Cmd::Run {
+            quick,
+            out,
+            reps,
+            only,
+            wait,
+            scenarios,
+            bin_dir,
+            work,
+            idle_wait,
+        } => {
+            let bench = std::env::current_exe().map_err(|e| format!("own path: {e}"))?;
+            let dir = bin_dir
+                .or_else(|| bench.parent().map(PathBuf::from))
+                .unwrap_or_default();
+            for b in ["attsync", "attsync-agent", "attsync-leader"] {
+                if !dir.join(b).is_file() {
+                    return Err(format!(
+                        "{} is missing: build with `cargo build --release --workspace` or pass --bin-dir",
+                        dir.join(b).display()
+                    ));
+                }
+            }
+            let scenarios = scenarios.unwrap_or_else(|| {
+                let local = PathBuf::from("scenarios/paper");
+                if local.is_dir() {
+                    local
+                } else {
+                    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper"))
+                }
+            });
+            let (work, temporary) = match work {
+                Some(w) => (w, false),
+                None => (
+                    std::env::temp_dir().join(format!("attsync-bench-{}", std::process::id())),
+                    true,
+                ),
+            };
+            let opts = suite::Options {
+                quick,
+                reps,
+                only,
+                waits: wait.into_iter().map(WaitStrategy::from).collect(),
+                scenarios,
+                work: work.clone(),
+                idle_wait: std::time::Duration::from_secs(idle_wait),
+                bins: measure::Bins {
+                    attsync: dir.join("attsync"),
+                    bench,
+                },
+            };
+            let result = suite::run(&opts);
+            if temporary {
+                let _ = std::fs::remove_dir_all(&work);
+            }
+            let report = result?;
+            println!("{report}");
+            if let Some(path) = out {
+                std::fs::write(&path, &report).map_err(|e| format!("{}: {e}", path.display()))?;
+            }
+            Ok(())
+        }
+    }
+}

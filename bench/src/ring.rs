@@ -1,0 +1,402 @@
+//! `attsync-bench ring-node …`: one process of a **bare iceoryx2 lockstep
+//! ring** (or, with `--inputs/--outputs`, of a bare lockstep over any given
+//! graph). It is started by `attsync-bench run`, never by hand; to try one
+//! by hand, start `--n N` of them with the same `--run/--root` and create
+//! the file `ROOT/start` once every `ROOT/ready-<i>` exists.
+//!
+//! It does exactly what an attsync node does per exchange, minus the model:
+//! the same per-run namespace ([`msgs::namespace::config`]), the same openers
+//! ([`msgs::open::state`], [`msgs::open::wake`]) with a [`Limits`] built here
+//! (nodes N, max_fanout 2, state_buffer 64, telemetry_buffer 256), the same
+//! 144-byte [`StateMsg`], the same publisher backpressure (`RetryUntilDelivered`,
+//! yield and retry until the stage timeout) and the same
+//! [`attsync_agent::wait::Waiter`]. Per step: 4 exchanges; per exchange:
+//! publish, notify the receivers (if the strategy lets them block), then take
+//! each input's message, one at a time, and check its (step, stage) stamp.
+//!
+//! Barriers: (1) readiness like the runtime: both inputs have a publisher and
+//! our state service has as many subscribers as we have receivers (bounded);
+//! then the node attaches its subscribers (`update_connections`) and creates
+//! `ROOT/ready-<i>`; (2) start: it polls (1 ms, like the
+//! runtime's control poll) for `ROOT/start`, which the driver creates once
+//! every node is ready; (3) finish: after its last exchange it creates
+//! `ROOT/done-<i>` and waits until every receiver has also finished (so that
+//! its last samples are consumed before its publisher goes away). Every wait
+//! is bounded.
+//!
+//! Output: one line on stdout,
+//! `ring-node index=I steps=S start_unix=T0 end_unix=T1 elapsed=E peak_rss_kb=K`
+//! (times in seconds; `elapsed` covers the lockstep loop only).
+
+use attsync_agent::wait::Waiter;
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::port::{BackpressureAction, BackpressureInfo};
+use iceoryx2::prelude::*;
+use msgs::config::WaitStrategy;
+use msgs::{Limits, PROTOCOL_VERSION, StateMsg};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// What one ring node does (parsed from the `ring-node` command line).
+#[derive(Debug, Clone)]
+pub struct RingNode {
+    /// Run id: iceoryx2 namespace `attsync/<run>/`, file prefix `as<run>_`.
+    pub run: String,
+    /// Directory of the run: iceoryx2 root `ROOT/iox/`, barrier files in `ROOT/`.
+    pub root: PathBuf,
+    /// This node's id (its index on the ring).
+    pub index: u32,
+    /// Number of nodes.
+    pub n: u32,
+    /// Integrator steps (4 exchanges each).
+    pub steps: u64,
+    /// Waiting strategy.
+    pub wait: WaitStrategy,
+    /// Ids whose state this node reads; default: ring neighbours i−1, i+1 (mod N).
+    pub inputs: Option<Vec<u32>>,
+    /// Ids that read this node's state; default: ring neighbours i−1, i+1 (mod N).
+    pub outputs: Option<Vec<u32>>,
+    /// `Limits::max_fanout` of the run; default 2.
+    pub max_fanout: usize,
+    /// Longest wait for one exchange's inputs, s.
+    pub stage_timeout: f64,
+    /// Longest wait for each barrier, s.
+    pub barrier_timeout: f64,
+}
+
+/// What a ring node measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RingReport {
+    /// Node id.
+    pub index: u32,
+    /// Steps done.
+    pub steps: u64,
+    /// Wall-clock time at the start of the lockstep loop, s since the epoch.
+    pub start_unix: f64,
+    /// Wall-clock time at its end, s since the epoch.
+    pub end_unix: f64,
+    /// Duration of the lockstep loop (monotonic clock), s.
+    pub elapsed: f64,
+    /// Peak resident set size (VmHWM), kB.
+    pub peak_rss_kb: u64,
+}
+
+impl RingReport {
+    /// The stdout line.
+    #[must_use]
+    pub fn line(&self) -> String {
+        format!(
+            "ring-node index={} steps={} start_unix={:.6} end_unix={:.6} elapsed={:.6} peak_rss_kb={}",
+            self.index, self.steps, self.start_unix, self.end_unix, self.elapsed, self.peak_rss_kb
+        )
+    }
+
+    /// Parses [`RingReport::line`].
+    #[must_use]
+    pub fn parse(line: &str) -> Option<Self> {
+        let mut r = Self {
+            index: 0,
+            steps: 0,
+            start_unix: 0.0,
+            end_unix: 0.0,
+            elapsed: 0.0,
+            peak_rss_kb: 0,
+        };
+        let mut seen = 0;
+        for tok in line.strip_prefix("ring-node ")?.split_whitespace() {
+            let (k, v) = tok.split_once('=')?;
+            match k {
+                "index" => r.index = v.parse().ok()?,
+                "steps" => r.steps = v.parse().ok()?,
+                "start_unix" => r.start_unix = v.parse().ok()?,
+                "end_unix" => r.end_unix = v.parse().ok()?,
+                "elapsed" => r.elapsed = v.parse().ok()?,
+                "peak_rss_kb" => r.peak_rss_kb = v.parse().ok()?,
+                _ => return None,
+            }
+            seen += 1;
+        }
+        (seen == 6).then_some(r)
+    }
+}
+
+/// Barrier file names under the run directory.
+pub mod files {
+    /// Created by node `i` once it is connected.
+    #[must_use]
+    pub fn ready(i: u32) -> String {
+        format!("ready-{i}")
+    }
+    /// Created by the driver once every node is ready.
+    pub const START: &str = "start";
+    /// Created by node `i` after its last exchange.
+    #[must_use]
+    pub fn done(i: u32) -> String {
+        format!("done-{i}")
+    }
+}
+
+fn unix_now() -> f64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64())
+}
+
+/// Polls (every millisecond) until `cond` holds; `Err` after `timeout`.
+fn poll_until(
+    timeout: Duration,
+    what: impl Fn() -> String,
+    mut cond: impl FnMut() -> bool,
+) -> Result<(), String> {
+    let deadline = Instant::now() + timeout;
+    while !cond() {
+        if Instant::now() > deadline {
+            return Err(format!(
+                "timed out after {:.1} s waiting for {}",
+                timeout.as_secs_f64(),
+                what()
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    Ok(())
+}
+
+fn touch(path: &Path) -> Result<(), String> {
+    std::fs::write(path, b"").map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The runtime's backpressure handler: yield and retry until `timeout`, then fail the send.
+fn retry_until(
+    timeout: Duration,
+) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send + 'static {
+    move |info| {
+        if info.elapsed_time > timeout {
+            BackpressureAction::DiscardDataAndFail
+        } else {
+            std::thread::yield_now();
+            BackpressureAction::Retry
+        }
+    }
+}
+
+fn port<E: std::fmt::Debug>(what: &str) -> impl FnOnce(E) -> String + '_ {
+    move |e| format!("{what}: {e:?}")
+}
+
+impl RingNode {
+    /// The node's inputs and outputs.
+    fn topology(&self) -> Result<(Vec<u32>, Vec<u32>), String> {
+        let ring_mode = self.inputs.is_none() || self.outputs.is_none();
+        if ring_mode && self.n < 3 {
+            return Err("a ring needs at least 3 nodes".into());
+        }
+        if ring_mode && self.index >= self.n {
+            return Err(format!("index {} not below n = {}", self.index, self.n));
+        }
+        let ring = vec![
+            (self.index + self.n - 1) % self.n,
+            (self.index + 1) % self.n,
+        ];
+        Ok((
+            self.inputs.clone().unwrap_or_else(|| ring.clone()),
+            self.outputs.clone().unwrap_or(ring),
+        ))
+    }
+
+    /// Runs the node: connect, barriers, lockstep loop, finish barrier.
+    pub fn run(&self) -> Result<RingReport, String> {
+        let (inputs, outputs) = self.topology()?;
+        let (run, id) = (self.run.as_str(), self.index);
+        let limits = Limits {
+            nodes: self.n as usize,
+            max_fanout: self.max_fanout,
+            state_buffer: 64,
+            telemetry_buffer: 256,
+        };
+        let stage_timeout = Duration::from_secs_f64(self.stage_timeout);
+        let barrier = Duration::from_secs_f64(self.barrier_timeout);
+
+        set_log_level(LogLevel::Error);
+        let cfg = msgs::namespace::config(run, &self.root.join("iox"))?;
+        let name = format!("ring_{id}");
+        let node = NodeBuilder::new()
+            .name(&name.as_str().try_into().map_err(port("node name"))?)
+            .config(&cfg)
+            .signal_handling_mode(SignalHandlingMode::Disabled)
+            .create::<ipc::Service>()
+            .map_err(port("iceoryx2 node"))?;
+
+        // Ports, opened exactly as the node runtime opens them.
+        let own = msgs::open::state(&node, run, id, &limits).map_err(|e| e.to_string())?;
+        let publisher = own
+            .publisher_builder()
+            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+            .set_backpressure_handler(retry_until(stage_timeout))
+            .create()
+            .map_err(port("state publisher"))?;
+        let listener = msgs::open::wake(&node, run, id, &limits)
+            .map_err(|e| e.to_string())?
+            .listener_builder()
+            .create()
+            .map_err(port("wake listener"))?;
+        let mut subs = Vec::new();
+        let mut input_services = Vec::new();
+        for &j in &inputs {
+            let svc = msgs::open::state(&node, run, j, &limits).map_err(|e| e.to_string())?;
+            subs.push(
+                svc.subscriber_builder()
+                    .buffer_size(limits.state_buffer)
+                    .create()
+                    .map_err(port("state subscriber"))?,
+            );
+            input_services.push(svc);
+        }
+        let notifiers = outputs
+            .iter()
+            .map(|&j| {
+                msgs::open::wake(&node, run, j, &limits)
+                    .map_err(|e| e.to_string())?
+                    .notifier_builder()
+                    .create()
+                    .map_err(port("wake notifier"))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+
+        // Readiness barrier (as in the runtime), then the start barrier.
+        poll_until(
+            barrier,
+            || {
+                format!(
+                    "connections (receivers {}/{})",
+                    own.dynamic_config().number_of_subscribers(),
+                    outputs.len()
+                )
+            },
+            || {
+                own.dynamic_config().number_of_subscribers() >= outputs.len()
+                    && input_services
+                        .iter()
+                        .all(|s| s.dynamic_config().number_of_publishers() >= 1)
+            },
+        )?;
+        // Attach the subscribers to their publishers now rather than at the
+        // first receive (as the runtime does since it learnt to).
+        for sub in &subs {
+            sub.update_connections().map_err(port("connect input"))?;
+        }
+        touch(&self.root.join(files::ready(id)))?;
+        let start_file = self.root.join(files::START);
+        poll_until(barrier, || "the start file".into(), || start_file.exists())?;
+
+        // Lockstep.
+        let mut waiter = Waiter::new(self.wait);
+        let notify = waiter.receivers_may_block();
+        let start_unix = unix_now();
+        let t0 = Instant::now();
+        for n in 0..self.steps {
+            for s in 0..4u32 {
+                publisher
+                    .send_copy(StateMsg {
+                        version: PROTOCOL_VERSION,
+                        sender: id,
+                        step: n,
+                        stage: s,
+                        reserved: 0,
+                        r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                        w: [0.0; 3],
+                        s: [0.0; 3],
+                    })
+                    .map_err(port("state send"))?;
+                if notify {
+                    for nt in &notifiers {
+                        let _ = nt.notify();
+                    }
+                }
+                let deadline = Instant::now() + stage_timeout;
+                waiter.begin();
+                for (k, sub) in subs.iter().enumerate() {
+                    let msg = loop {
+                        if let Some(sample) = sub.receive().map_err(port("state receive"))? {
+                            break *sample;
+                        }
+                        if waiter.wait(&listener, deadline) {
+                            return Err(format!(
+                                "timed out after {} s waiting for node {}'s step {n} stage {s}",
+                                self.stage_timeout, inputs[k]
+                            ));
+                        }
+                    };
+                    if msg.version != PROTOCOL_VERSION
+                        || msg.sender != inputs[k]
+                        || (msg.step, msg.stage) != (n, s)
+                    {
+                        return Err(format!(
+                            "node {} sent sender {} step {} stage {} where step {n} stage {s} was due",
+                            inputs[k], msg.sender, msg.step, msg.stage
+                        ));
+                    }
+                }
+            }
+        }
+        let elapsed = t0.elapsed().as_secs_f64();
+        let end_unix = unix_now();
+
+        // Finish barrier: our receivers have consumed our last messages.
+        touch(&self.root.join(files::done(id)))?;
+        poll_until(
+            barrier,
+            || "the receivers to finish".into(),
+            || {
+                outputs
+                    .iter()
+                    .all(|&j| self.root.join(files::done(j)).exists())
+            },
+        )?;
+        Ok(RingReport {
+            index: id,
+            steps: self.steps,
+            start_unix,
+            end_unix,
+            elapsed,
+            peak_rss_kb: attsync_agent::runtime::peak_rss_kb(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn report_line_round_trips() {
+        let r = RingReport {
+            index: 3,
+            steps: 40000,
+            start_unix: 1_700_000_000.123_456,
+            end_unix: 1_700_000_004.5,
+            elapsed: 4.376_544,
+            peak_rss_kb: 4321,
+        };
+        assert_eq!(RingReport::parse(&r.line()), Some(r));
+        assert_eq!(RingReport::parse("ring-node index=1"), None);
+    }
+
+    #[test]
+    fn ring_neighbours_wrap() {
+        let node = RingNode {
+            run: "x".into(),
+            root: PathBuf::from("/nonexistent"),
+            index: 0,
+            n: 8,
+            steps: 1,
+            wait: WaitStrategy::Block,
+            inputs: None,
+            outputs: None,
+            max_fanout: 2,
+            stage_timeout: 1.0,
+            barrier_timeout: 1.0,
+        };
+        assert_eq!(node.topology().unwrap(), (vec![7, 1], vec![7, 1]));
+    }
+}

@@ -1,0 +1,161 @@
+//! Small helpers of `attsync-bench run`: medians, background CPU load, and
+//! the machine description. See `main.rs` for how to run the benchmark.
+
+/// Median (mean of the two middle values for an even count); `None` if empty.
+#[must_use]
+pub fn median(values: &[f64]) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let m = v.len() / 2;
+    Some(if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    })
+}
+
+/// Median of integers (lower middle for an even count).
+#[must_use]
+pub fn median_u64(values: &[u64]) -> Option<u64> {
+    let mut v = values.to_vec();
+    v.sort_unstable();
+    v.get(v.len().saturating_sub(1) / 2).copied()
+}
+
+/// Clock ticks per second of `/proc` CPU times (Linux uses 100).
+const TICKS: f64 = 100.0;
+
+fn machine_busy_ticks() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/stat").ok()?;
+    let f: Vec<u64> = text
+        .lines()
+        .next()?
+        .split_whitespace()
+        .skip(1)
+        .filter_map(|x| x.parse().ok())
+        .collect();
+    // user nice system idle iowait irq softirq steal …: all but idle and iowait.
+    Some(f.iter().take(8).sum::<u64>() - f.get(3)? - f.get(4)?)
+}
+
+fn own_ticks() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which ends with ')'): utime is the 14th field.
+    let rest = &text[text.rfind(')')? + 2..];
+    let f: Vec<u64> = rest
+        .split_whitespace()
+        .map(|x| x.parse().unwrap_or(0))
+        .collect();
+    // rest[0] is field 3; utime, stime, cutime, cstime are fields 14..17.
+    Some(f.get(11)? + f.get(12)? + f.get(13)? + f.get(14)?)
+}
+
+/// Measures how busy the machine was with *other* work during a
+/// measurement: machine CPU time minus this process's and its waited-for
+/// descendants' CPU time, per wall second (in cores).
+#[derive(Debug, Clone, Copy)]
+pub struct CpuMeter {
+    busy: Option<u64>,
+    mine: Option<u64>,
+    t0: std::time::Instant,
+}
+
+impl CpuMeter {
+    /// Starts measuring.
+    #[must_use]
+    pub fn start() -> Self {
+        Self {
+            busy: machine_busy_ticks(),
+            mine: own_ticks(),
+            t0: std::time::Instant::now(),
+        }
+    }
+
+    /// Cores' worth of CPU used by other processes since [`CpuMeter::start`]
+    /// (call after the children have been waited for).
+    #[must_use]
+    pub fn foreign_cores(&self) -> Option<f64> {
+        let busy = machine_busy_ticks()?.checked_sub(self.busy?)?;
+        let mine = own_ticks()?.checked_sub(self.mine?)?;
+        let wall = self.t0.elapsed().as_secs_f64();
+        (wall > 0.0).then(|| (busy as f64 - mine as f64).max(0.0) / TICKS / wall)
+    }
+}
+
+/// Waits until the machine has been idle (other processes using under
+/// `threshold` cores over half a second) or `max` has passed; returns whether
+/// it was idle. Call it between measurements, when no child is running.
+#[must_use]
+pub fn wait_idle(threshold: f64, max: std::time::Duration) -> bool {
+    let t0 = std::time::Instant::now();
+    loop {
+        let m = CpuMeter::start();
+        std::thread::sleep(std::time::Duration::from_millis(500));
+        match m.foreign_cores() {
+            Some(c) if c < threshold => return true,
+            None => return true,
+            Some(_) if t0.elapsed() >= max => return false,
+            Some(_) => {}
+        }
+    }
+}
+
+/// `nproc`, CPU model, RAM.
+#[must_use]
+pub fn machine() -> String {
+    let cpus = std::thread::available_parallelism().map_or(0, std::num::NonZero::get);
+    let model = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let ram_kb = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("MemTotal:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse::<u64>().ok())
+        })
+        .unwrap_or(0);
+    format!(
+        "{cpus} CPUs (nproc), {model}, {:.1} GiB RAM",
+        ram_kb as f64 / 1024.0 / 1024.0
+    )
+}
+
+/// The 1-, 5- and 15-minute load averages.
+#[must_use]
+pub fn loadavg() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|t| t.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "?".into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn medians() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
+        assert_eq!(median(&[]), None);
+        assert_eq!(median_u64(&[9, 1, 5]), Some(5));
+        assert_eq!(median_u64(&[4, 1, 2, 3]), Some(2));
+        assert_eq!(median_u64(&[]), None);
+    }
+
+    #[test]
+    fn cpu_meter_reads_proc() {
+        assert!(CpuMeter::start().foreign_cores().is_some() || !cfg!(target_os = "linux"));
+    }
+}
