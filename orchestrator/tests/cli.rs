@@ -25,7 +25,13 @@ const OBSERVERLESS: &str = concat!(
     "/../scenarios/paper/constant-observerless.toml"
 );
 const HEADER: &str = "t,agent,att_err,angvel_err,obs_att_err,obs_angvel_err";
-const RESULT_FILES: [&str; 4] = ["errors.csv", "errors.svg", "scenario.toml", "summary.json"];
+const RESULT_FILES: [&str; 5] = [
+    "errors.csv",
+    "errors.svg",
+    "scenario.toml",
+    "states.bin",
+    "summary.json",
+];
 
 /// What a finished `attsync` process left.
 struct Out {

@@ -490,13 +490,15 @@ fn namespace_entries() -> BTreeSet<PathBuf> {
     out
 }
 
-/// The runs whose `owner` file holds `pid`.
+/// The runs whose `owner` file holds `pid` (hidden `.<run>.creating`
+/// directories are namespaces still being set up and are not counted).
 #[must_use]
 pub fn owned_runs(pid: u32) -> Vec<String> {
     let Ok(rd) = fs::read_dir(iox_base()) else {
         return Vec::new();
     };
     rd.filter_map(Result::ok)
+        .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
         .filter(|e| {
             fs::read_to_string(e.path().join("owner"))
                 .is_ok_and(|owner| owner.trim() == pid.to_string())

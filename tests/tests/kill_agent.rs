@@ -213,12 +213,14 @@ fn incomplete_reason_names_an_existing_log() {
     let s = summary(&k.out);
     let reason = s["incomplete_reason"].as_str().unwrap_or_default();
     let log = reason
-        .split("last lines of ")
+        .split("(logs/")
         .nth(1)
-        .and_then(|r| r.split(":\n").next())
+        .and_then(|r| r.split(" in the results directory").next())
+        .map(|name| k.out.join("logs").join(name))
         .unwrap_or_else(|| panic!("the reason names no log: {reason:?}"));
     assert!(
-        std::path::Path::new(log).is_file(),
-        "the reason names {log}, which does not exist (reason: {reason:?})"
+        log.is_file(),
+        "the reason names {}, which does not exist (reason: {reason:?})",
+        log.display()
     );
 }
