@@ -119,6 +119,10 @@ pub struct LinkStats {
     pub age_max: f64,
     /// Stages evaluated.
     pub evaluations: u64,
+    /// Messages the receiver refused as invalid (non-finite numbers, or a
+    /// matrix that is not a rotation); counted by the process runtime.
+    #[serde(default)]
+    pub rejected: u64,
 }
 
 /// A message on its way: delivery slot, stamp, value (ordered by slot, then stamp).

@@ -303,6 +303,7 @@ impl RingNode {
                         step: n,
                         stage: s,
                         reserved: 0,
+                        sent_unix_ns: 0,
                         r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
                         w: [0.0; 3],
                         s: [0.0; 3],

@@ -76,6 +76,11 @@ pub struct NodeConfig {
     pub stage_timeout: f64,
     /// Longest wait for connections and the start command, s.
     pub start_timeout: f64,
+    /// Real-time mode: `Some(factor)` runs free against the wall clock at
+    /// `factor` simulated seconds per wall second, never waiting for
+    /// inputs; `None` (the default) is deterministic lockstep.
+    #[serde(default)]
+    pub realtime: Option<f64>,
     /// The node's role and model.
     pub role: Role,
 }

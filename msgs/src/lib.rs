@@ -21,5 +21,6 @@ pub mod payload;
 
 pub use open::Limits;
 pub use payload::{
-    ControlCommand, ControlMsg, PROTOCOL_VERSION, StateMsg, TelemetryKind, TelemetryMsg,
+    ControlCommand, ControlMsg, Invalid, PROTOCOL_VERSION, ROTATION_TOLERANCE, StateMsg,
+    TelemetryKind, TelemetryMsg, unix_ns_now,
 };

@@ -9,7 +9,7 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layouts and the stepping rules. A receiver refuses
 /// a message whose `version` differs.
-pub const PROTOCOL_VERSION: u32 = 1;
+pub const PROTOCOL_VERSION: u32 = 2;
 
 /// Row-major copy of a matrix.
 #[must_use]
@@ -42,6 +42,10 @@ pub struct StateMsg {
     pub stage: u32,
     /// Reserved, 0.
     pub reserved: u32,
+    /// Wall-clock time of publication, ns since the Unix epoch (0 if the
+    /// sender does not stamp). Only real-time mode reads it, to measure the
+    /// age of information; lockstep results never depend on it.
+    pub sent_unix_ns: u64,
     /// Attitude (body → inertial), row-major.
     pub r: [f64; 9],
     /// Angular velocity, body frame, rad/s.
@@ -60,10 +64,36 @@ impl StateMsg {
             step,
             stage,
             reserved: 0,
+            sent_unix_ns: 0,
             r: to_rows(&x.r),
             w: x.w.into(),
             s: x.s.into(),
         }
+    }
+
+    /// The same message stamped with the current wall-clock time.
+    #[must_use]
+    pub fn stamped_now(self) -> Self {
+        Self {
+            sent_unix_ns: unix_ns_now(),
+            ..self
+        }
+    }
+
+    /// The exchanged state if its values can be trusted: every number
+    /// finite and `r` a rotation (`‖rᵀr − I‖_F ≤` [`ROTATION_TOLERANCE`],
+    /// `det r > 0`). Values from another process are never used unchecked.
+    pub fn validated(&self) -> Result<Exchanged, Invalid> {
+        let all = self.r.iter().chain(&self.w).chain(&self.s);
+        if all.clone().any(|v| !v.is_finite()) {
+            return Err(Invalid::NonFinite);
+        }
+        let x = self.exchanged();
+        let defect = attitude::so3::orthogonality_defect(&x.r);
+        if defect > ROTATION_TOLERANCE || x.r.determinant() <= 0.0 {
+            return Err(Invalid::NotARotation(defect));
+        }
+        Ok(x)
     }
 
     /// The exchanged state (exact copy of the sent values).
@@ -77,6 +107,39 @@ impl StateMsg {
     }
 }
 
+/// Largest `‖rᵀr − I‖_F` a received attitude may have. attsync's own
+/// integrator keeps it near 1e-12; 1e-6 admits any honest f64 rotation.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
+
+/// Why a received state was refused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Invalid {
+    /// A NaN or an infinity.
+    NonFinite,
+    /// `r` is not a rotation (its orthogonality defect, or a reflection).
+    NotARotation(f64),
+}
+
+impl std::fmt::Display for Invalid {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NonFinite => write!(f, "a value is NaN or infinite"),
+            Self::NotARotation(d) => write!(
+                f,
+                "the attitude is not a rotation (‖RᵀR − I‖ = {d:.3e}, or det R ≤ 0)"
+            ),
+        }
+    }
+}
+
+/// Nanoseconds since the Unix epoch, now (`CLOCK_REALTIME`).
+#[must_use]
+pub fn unix_ns_now() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos() as u64)
+}
+
 /// What a telemetry message reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u32)]
@@ -85,12 +148,17 @@ pub enum TelemetryKind {
     Ready = 1,
     /// The node's state at an output sample (`step` is the step index).
     Sample = 2,
-    /// The node has done its last step; `peak_torque` is final.
+    /// The node has done its last step; `peak_torque` is final. In
+    /// real-time mode `w` = [stages started late, largest lateness (wall s), 0].
     Done = 3,
     /// Counters of one incoming link, sent before `Done`: `step` = the
     /// sender's id, `w` = [sent, delivered, lost], `w_hat` = [sum of the age
-    /// of information over evaluated stages (s), largest age (s), stages evaluated].
+    /// of information over evaluated stages (s), largest age (s), stages
+    /// evaluated], `s_hat[0]` = messages rejected as invalid.
     LinkStats = 4,
+    /// The node gives up because an input's state did not arrive in time:
+    /// `step` = that input's node id. Sent just before the node exits.
+    Failed = 5,
 }
 
 impl TelemetryKind {
@@ -102,6 +170,7 @@ impl TelemetryKind {
             2 => Some(Self::Sample),
             3 => Some(Self::Done),
             4 => Some(Self::LinkStats),
+            5 => Some(Self::Failed),
             _ => None,
         }
     }
@@ -189,6 +258,7 @@ impl TelemetryMsg {
         Self {
             w: [s.sent as f64, s.delivered as f64, s.lost as f64],
             w_hat: [s.age_sum, s.age_max, s.evaluations as f64],
+            s_hat: [s.rejected as f64, 0.0, 0.0],
             ..Self::bare(sender, u64::from(from), TelemetryKind::LinkStats, 0.0)
         }
     }
@@ -205,6 +275,7 @@ impl TelemetryMsg {
                 age_sum: self.w_hat[0],
                 age_max: self.w_hat[1],
                 evaluations: self.w_hat[2] as u64,
+                rejected: self.s_hat[0] as u64,
             },
         )
     }
@@ -252,6 +323,10 @@ pub struct ControlMsg {
     pub version: u32,
     /// [`ControlCommand`] as `u32`.
     pub command: u32,
+    /// For `Start`: the wall-clock time at which simulated time 0 begins,
+    /// ns since the Unix epoch (real-time mode paces every node from it;
+    /// lockstep ignores it). 0 otherwise.
+    pub start_unix_ns: u64,
 }
 
 impl ControlMsg {
@@ -261,6 +336,16 @@ impl ControlMsg {
         Self {
             version: PROTOCOL_VERSION,
             command: command as u32,
+            start_unix_ns: 0,
+        }
+    }
+
+    /// `Start`, with simulated time 0 at `start_unix_ns`.
+    #[must_use]
+    pub fn start_at(start_unix_ns: u64) -> Self {
+        Self {
+            start_unix_ns,
+            ..Self::new(ControlCommand::Start)
         }
     }
 
@@ -284,15 +369,17 @@ mod tests {
     fn layouts_are_the_documented_ones() {
         assert_eq!(offset_of!(StateMsg, step), 8);
         assert_eq!(offset_of!(StateMsg, stage), 16);
-        assert_eq!(offset_of!(StateMsg, r), 24);
-        assert_eq!(offset_of!(StateMsg, w), 96);
-        assert_eq!(offset_of!(StateMsg, s), 120);
-        assert_eq!(size_of::<StateMsg>(), 144);
+        assert_eq!(offset_of!(StateMsg, sent_unix_ns), 24);
+        assert_eq!(offset_of!(StateMsg, r), 32);
+        assert_eq!(offset_of!(StateMsg, w), 104);
+        assert_eq!(offset_of!(StateMsg, s), 128);
+        assert_eq!(size_of::<StateMsg>(), 152);
         assert_eq!(offset_of!(TelemetryMsg, r), 24);
         assert_eq!(offset_of!(TelemetryMsg, r_hat), 120);
         assert_eq!(offset_of!(TelemetryMsg, peak_torque), 240);
         assert_eq!(size_of::<TelemetryMsg>(), 248);
-        assert_eq!(size_of::<ControlMsg>(), 8);
+        assert_eq!(offset_of!(ControlMsg, start_unix_ns), 8);
+        assert_eq!(size_of::<ControlMsg>(), 16);
         assert_eq!(align_of::<StateMsg>(), 8);
     }
 
@@ -306,5 +393,26 @@ mod tests {
         let m = StateMsg::new(4, 17, 2, &x);
         assert_eq!(m.exchanged(), x);
         assert_eq!(m.r[1], x.r[(0, 1)]);
+        assert_eq!(m.validated(), Ok(x));
+    }
+
+    #[test]
+    fn untrustworthy_states_are_refused() {
+        let x = Exchanged::identity();
+        let mut m = StateMsg::new(1, 0, 0, &x);
+        m.w[2] = f64::NAN;
+        assert_eq!(m.validated(), Err(Invalid::NonFinite));
+        let mut m = StateMsg::new(1, 0, 0, &x);
+        m.s[0] = f64::INFINITY;
+        assert_eq!(m.validated(), Err(Invalid::NonFinite));
+        let mut m = StateMsg::new(1, 0, 0, &x);
+        m.r[0] = 1.001;
+        assert!(matches!(m.validated(), Err(Invalid::NotARotation(d)) if d > 1e-3));
+        let mut m = StateMsg::new(1, 0, 0, &x);
+        m.r[8] = -1.0; // a reflection is orthogonal but not a rotation
+        assert!(matches!(m.validated(), Err(Invalid::NotARotation(_))));
+        let mut m = StateMsg::new(1, 0, 0, &x);
+        m.r[1] = 1e-9; // round-off is accepted
+        assert!(m.validated().is_ok());
     }
 }

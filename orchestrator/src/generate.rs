@@ -69,6 +69,8 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
             omega,
             control_gain,
             observer,
+            command: None,
+            env: None,
         });
     }
     let (c_edge, c_link) = if has_obs { (10.0, 14.0) } else { (3.0, 5.0) };

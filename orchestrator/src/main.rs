@@ -3,7 +3,7 @@
 use anyhow::Context;
 use attsync::generate::{TreeParams, tree};
 use attsync::processes::ProcessOptions;
-use attsync::run::{Engine, RunOptions, run};
+use attsync::run::{Engine, RunError, RunOptions, run};
 use attsync::scenario::{self, ScenarioError, schema::SchemeKind};
 use clap::{Parser, Subcommand, ValueEnum};
 use msgs::config::WaitStrategy;
@@ -44,6 +44,12 @@ enum Command {
         /// Longest wait of a node for one stage's inputs, s (processes engine).
         #[arg(long, default_value_t = 10.0)]
         stage_timeout: f64,
+        /// Real-time mode: nodes run free against the wall clock at FACTOR
+        /// simulated seconds per wall second [default FACTOR: 1], never wait for
+        /// their inputs, and the links' measured age of information is reported.
+        /// Not deterministic. Without it: deterministic lockstep.
+        #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]
+        realtime: Option<f64>,
         /// Results directory [default: results/<scenario name>].
         #[arg(long)]
         out: Option<PathBuf>,
@@ -175,6 +181,10 @@ fn main() -> ExitCode {
                 eprintln!("{se}");
                 return ExitCode::from(2);
             }
+            if let Some(RunError::Options(why)) = e.downcast_ref::<RunError>() {
+                eprintln!("error: {why}");
+                return ExitCode::from(2);
+            }
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
@@ -193,6 +203,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             engine,
             wait,
             stage_timeout,
+            realtime,
             out,
             set,
             quiet,
@@ -213,6 +224,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 processes: ProcessOptions {
                     wait,
                     stage_timeout,
+                    realtime,
                     ..ProcessOptions::default()
                 },
                 progress: !quiet && std::io::stderr().is_terminal(),

@@ -58,6 +58,9 @@ pub enum RunError {
     /// The process engine could not start.
     #[error(transparent)]
     Processes(#[from] ProcessError),
+    /// The options do not fit the scenario.
+    #[error("{0}")]
+    Options(String),
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -84,6 +87,9 @@ pub fn run(
     interrupt: &AtomicBool,
 ) -> Result<Summary, RunError> {
     let net = &loaded.resolved.network;
+    check_options(loaded, opts)?;
+    let mut process_opts = opts.processes.clone();
+    process_opts.plugins = loaded.resolved.plugins.clone();
     let staging = Staging::new(&opts.out).map_err(io_at(&opts.out))?;
     let dir = staging.path().to_owned();
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
@@ -101,7 +107,7 @@ pub fn run(
         bar.set_position(snap.step);
         true
     };
-    let (peaks, steps, failure, links) = match opts.engine {
+    let (peaks, steps, failure, links, pacing) = match opts.engine {
         Engine::InProcess => {
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
@@ -129,11 +135,12 @@ pub fn run(
                 engine.step_index(),
                 interrupted.then(|| "interrupted".to_string()),
                 links,
+                Vec::new(),
             )
         }
         Engine::Processes => {
-            let out = processes::run(net, &opts.processes, &dir.join("logs"), interrupt, record)?;
-            (out.peak_torques, out.steps, out.failure, out.links)
+            let out = processes::run(net, &process_opts, &dir.join("logs"), interrupt, record)?;
+            (out.peak_torques, out.steps, out.failure, out.links, out.pacing)
         }
     };
     let wall_seconds = started.elapsed().as_secs_f64();
@@ -142,7 +149,20 @@ pub fn run(
         return Err(io_at(&dir)(e));
     }
     let series = recorder.finish().map_err(io_at(&dir))?;
-    let agents = results::agent_summaries(&series, &peaks);
+    let mut agents = results::agent_summaries(&series, &peaks);
+    for (a, p) in agents.iter_mut().zip(&pacing) {
+        if opts.processes.realtime.is_some() {
+            (a.late_stages, a.max_lateness) = (Some(p.0), Some(p.1));
+        }
+    }
+    for a in &mut agents {
+        a.plugin = loaded
+            .resolved
+            .plugins
+            .iter()
+            .find(|p| p.agent == a.id)
+            .map(|p| p.display());
+    }
     let summary = Summary {
         attsync_version: env!("CARGO_PKG_VERSION").into(),
         scenario: loaded.name(),
@@ -170,8 +190,10 @@ pub fn run(
                     0.0
                 },
                 aoi_max: st.age_max,
+                rejected: st.rejected,
             })
             .collect(),
+        realtime: opts.processes.realtime,
     };
     let svg = dir.join("errors.svg");
     plot::draw(
@@ -187,6 +209,50 @@ pub fn run(
     results::write_summary(&dir, &summary).map_err(io_at(&dir))?;
     staging.commit().map_err(io_at(&opts.out))?;
     Ok(summary)
+}
+
+/// Options that the scenario cannot run with.
+fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), RunError> {
+    let plugins = &loaded.resolved.plugins;
+    if opts.engine == Engine::InProcess {
+        if let Some(p) = plugins.first() {
+            return Err(RunError::Options(format!(
+                "agent {} is a plug-in (`{}`): plug-ins need --engine processes",
+                p.agent,
+                p.display()
+            )));
+        }
+        if opts.processes.realtime.is_some() {
+            return Err(RunError::Options(
+                "--realtime needs --engine processes (the in-process engine is lockstep only)"
+                    .into(),
+            ));
+        }
+    }
+    if let Some(f) = opts.processes.realtime {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(RunError::Options(format!(
+                "--realtime {f}: the factor must be a positive number (simulated s per wall s)"
+            )));
+        }
+        let net = &loaded.resolved.network;
+        let impaired = net.agents.iter().any(|a| {
+            a.model
+                .neighbours
+                .iter()
+                .filter_map(|n| n.link)
+                .chain(a.model.leader_link)
+                .any(|l| l.is_impaired())
+        });
+        if impaired {
+            return Err(RunError::Options(
+                "--realtime cannot be combined with [network] impairments: they are defined in \
+                 simulated lockstep time; in real-time mode the transport's own latency is measured"
+                    .into(),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn progress_bar(enabled: bool, steps: u64, dt: f64) -> ProgressBar {

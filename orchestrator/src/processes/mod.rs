@@ -15,6 +15,7 @@ use iceoryx2::node::NodeBuilder;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use msgs::config::{NodeConfig, Role, WaitStrategy};
+use crate::scenario::plugin::Plugin;
 use msgs::{ControlCommand, ControlMsg, Limits, PROTOCOL_VERSION, TelemetryKind, TelemetryMsg};
 use namespace::Namespace;
 use std::collections::VecDeque;
@@ -33,6 +34,10 @@ pub struct ProcessOptions {
     pub stage_timeout: f64,
     /// Longest wait for connections and commands, s.
     pub start_timeout: f64,
+    /// Real-time mode: simulated seconds per wall second (`None`: lockstep).
+    pub realtime: Option<f64>,
+    /// Agents run by the user's own programs.
+    pub plugins: Vec<Plugin>,
 }
 
 impl Default for ProcessOptions {
@@ -41,9 +46,15 @@ impl Default for ProcessOptions {
             wait: WaitStrategy::Adaptive,
             stage_timeout: 10.0,
             start_timeout: 30.0,
+            realtime: None,
+            plugins: Vec::new(),
         }
     }
 }
+
+/// Time between the orchestrator's `Start` and simulated time 0 in
+/// real-time mode, so that every node has read `Start` before it is due.
+const REALTIME_LEAD: Duration = Duration::from_millis(50);
 
 /// The engine could not start.
 #[derive(Debug, Error)]
@@ -75,6 +86,9 @@ pub struct Outcome {
     pub failure: Option<String>,
     /// Counters of the impaired links: (from, to, stats).
     pub links: Vec<(u32, u32, LinkStats)>,
+    /// Real-time pacing per agent (network order): (stages started more
+    /// than a step late, largest lateness in wall s).
+    pub pacing: Vec<(u64, f64)>,
 }
 
 fn iox<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ProcessError {
@@ -88,6 +102,20 @@ fn node_name(net: &Network, index: usize) -> String {
     } else {
         format!("agent-{}", net.agents[index - 1].model.id)
     }
+}
+
+/// Node names for messages: a plug-in's name says so, with its command.
+fn node_label(net: &Network, plugins: &[Plugin], index: usize) -> String {
+    let name = node_name(net, index);
+    match plugin_of(net, plugins, index) {
+        Some(p) => format!("{name} (plug-in `{}`)", p.display()),
+        None => name,
+    }
+}
+
+fn plugin_of<'a>(net: &Network, plugins: &'a [Plugin], index: usize) -> Option<&'a Plugin> {
+    let id = (index > 0).then(|| net.agents[index - 1].model.id)?;
+    plugins.iter().find(|p| p.agent == id)
 }
 
 /// The per-node configurations of `net`.
@@ -120,6 +148,7 @@ pub fn node_configs(
         wait: opts.wait,
         stage_timeout: opts.stage_timeout,
         start_timeout: opts.start_timeout,
+        realtime: opts.realtime,
         role,
     };
     let mut out = vec![base(
@@ -211,14 +240,21 @@ pub fn run(
             path: file.clone(),
             source: std::io::Error::other(e),
         })?;
-        let bin = if i == 0 { &leader_bin } else { &agent_bin };
-        sup.spawn(
-            i,
-            bin,
-            &["--config".into(), file.to_string_lossy().into_owned()],
-            &log_of(i),
-        )
-        .map_err(io(&log_of(i)))?;
+        let file = file.to_string_lossy().into_owned();
+        let mut env = vec![("ATTSYNC_CONFIG".to_string(), file.clone())];
+        let config_arg = ["--config".to_string(), file];
+        let spawned = match plugin_of(net, &opts.plugins, i) {
+            Some(p) => {
+                env.extend(p.env.iter().map(|(k, v)| (k.clone(), v.clone())));
+                let args: Vec<String> = p.command[1..].iter().cloned().chain(config_arg).collect();
+                sup.spawn(i, Path::new(&p.command[0]), &args, &env, Some(&p.dir), &log_of(i))
+            }
+            None => {
+                let bin = if i == 0 { &leader_bin } else { &agent_bin };
+                sup.spawn(i, bin, &config_arg, &env, None, &log_of(i))
+            }
+        };
+        spawned.map_err(io(&log_of(i)))?;
     }
 
     let mut c = Collector {
@@ -228,6 +264,8 @@ pub fn run(
         peaks: vec![0.0; n_nodes],
         steps: 0,
         links: Vec::new(),
+        pacing: vec![(0, 0.0); n_nodes],
+        blamed: Vec::new(),
     };
     let failure = (|| -> Option<String> {
         // Phase 1: every node ready.
@@ -237,7 +275,7 @@ pub fn run(
             if let Err(e) = c.drain(&telemetry) {
                 return Some(e);
             }
-            if let Some(f) = check_exits(&mut sup, &c.done, net, &log_of) {
+            if let Some(f) = check_exits(&mut sup, &c.done, net, &opts.plugins, &log_of) {
                 return Some(f);
             }
             if interrupt.load(Ordering::Relaxed) {
@@ -246,7 +284,7 @@ pub fn run(
             if Instant::now() > deadline {
                 let missing: Vec<String> = (0..n_nodes)
                     .filter(|&i| !c.ready[i])
-                    .map(|i| node_name(net, i))
+                    .map(|i| node_label(net, &opts.plugins, i))
                     .collect();
                 return Some(format!(
                     "start-up timed out after {} s: not ready: {}",
@@ -255,10 +293,11 @@ pub fn run(
                 ));
             }
         }
-        if control
-            .send_copy(ControlMsg::new(ControlCommand::Start))
-            .is_err()
-        {
+        let start = match opts.realtime {
+            Some(_) => ControlMsg::start_at(msgs::unix_ns_now() + REALTIME_LEAD.as_nanos() as u64),
+            None => ControlMsg::new(ControlCommand::Start),
+        };
+        if control.send_copy(start).is_err() {
             return Some("cannot send Start".into());
         }
         // Phase 2: collect until every node is done.
@@ -291,7 +330,7 @@ pub fn run(
             if c.done.iter().all(|&d| d) && c.pending.iter().all(VecDeque::is_empty) {
                 return None;
             }
-            if let Some(f) = check_exits(&mut sup, &c.done, net, &log_of) {
+            if let Some(f) = check_exits(&mut sup, &c.done, net, &opts.plugins, &log_of) {
                 return Some(f);
             }
             if interrupt.load(Ordering::Relaxed) {
@@ -305,6 +344,15 @@ pub fn run(
             }
         }
     })();
+    // A node that gave up waiting says for whom: put that first.
+    let failure = failure.map(|f| {
+        std::thread::sleep(Duration::from_millis(20));
+        let _ = c.drain(&telemetry);
+        match c.blame(net, &opts.plugins) {
+            Some(b) => format!("{b}\n{f}"),
+            None => f,
+        }
+    });
 
     match &failure {
         None => {
@@ -313,12 +361,13 @@ pub fn run(
             let bad: Vec<String> = exits
                 .iter()
                 .filter(|e| !matches!(&e.status, Ok(s) if s.success()))
-                .map(|e| format!("{}: {}", node_name(net, e.index), describe(&e.status)))
+                .map(|e| format!("{}: {}", node_label(net, &opts.plugins, e.index), describe(&e.status)))
                 .collect();
             if !bad.is_empty() {
                 return Ok(Outcome {
                     peak_torques: c.peaks[1..].to_vec(),
                     links: std::mem::take(&mut c.links),
+                    pacing: c.pacing[1..].to_vec(),
                     steps: c.steps,
                     failure: Some(format!("nodes failed at shutdown: {}", bad.join("; "))),
                 });
@@ -338,6 +387,7 @@ pub fn run(
     Ok(Outcome {
         peak_torques: c.peaks[1..].to_vec(),
         links: c.links,
+        pacing: c.pacing[1..].to_vec(),
         steps: c.steps,
         failure,
     })
@@ -349,6 +399,7 @@ fn check_exits(
     sup: &mut Supervisor,
     done: &[bool],
     net: &Network,
+    plugins: &[Plugin],
     log_of: &dyn Fn(usize) -> PathBuf,
 ) -> Option<String> {
     while let Some(e) = sup.try_exit() {
@@ -356,7 +407,7 @@ fn check_exits(
         if !(done[e.index] && clean) {
             return Some(format!(
                 "{} ended during the run ({}); last lines of its log (logs/{}.log in the results directory):\n{}",
-                node_name(net, e.index),
+                node_label(net, plugins, e.index),
                 describe(&e.status),
                 node_name(net, e.index),
                 tail(&log_of(e.index), 10)
@@ -374,9 +425,42 @@ struct Collector {
     peaks: Vec<f64>,
     steps: u64,
     links: Vec<(u32, u32, LinkStats)>,
+    /// Real-time pacing per node: (stages started over a step late, largest lateness, s).
+    pacing: Vec<(u64, f64)>,
+    /// (node index, id of the input it timed out waiting for).
+    blamed: Vec<(usize, u32)>,
 }
 
 impl Collector {
+    /// Names the nodes others gave up waiting for, if any did.
+    fn blame(&self, net: &Network, plugins: &[Plugin]) -> Option<String> {
+        let mut silent: Vec<u32> = self.blamed.iter().map(|&(_, id)| id).collect();
+        silent.sort_unstable();
+        silent.dedup();
+        let lines: Vec<String> = silent
+            .iter()
+            .map(|&id| {
+                let index = if id == 0 {
+                    0
+                } else {
+                    1 + net.agents.iter().position(|a| a.model.id == id).unwrap_or(0)
+                };
+                let waiters: Vec<String> = self
+                    .blamed
+                    .iter()
+                    .filter(|&&(_, j)| j == id)
+                    .map(|&(i, _)| node_name(net, i))
+                    .collect();
+                format!(
+                    "{} stopped answering: {} timed out waiting for its state",
+                    node_label(net, plugins, index),
+                    waiters.join(", ")
+                )
+            })
+            .collect();
+        (!lines.is_empty()).then(|| lines.join("\n"))
+    }
+
     /// Reads every telemetry message available; `Ok(true)` if any arrived.
     fn drain(
         &mut self,
@@ -410,7 +494,9 @@ impl Collector {
                     Some(TelemetryKind::Done) => {
                         self.done[i] = true;
                         self.peaks[i] = m.peak_torque;
+                        self.pacing[i] = (m.w[0] as u64, m.w[1]);
                     }
+                    Some(TelemetryKind::Failed) => self.blamed.push((i, m.step as u32)),
                     None => {
                         return Err(format!(
                             "node {} sent telemetry of unknown kind {}",

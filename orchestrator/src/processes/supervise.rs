@@ -73,18 +73,25 @@ impl Supervisor {
         })
     }
 
-    /// Starts `program args…` as node `index`, stdout and stderr to `log`.
+    /// Starts `program args…` as node `index` (with `env` added to the
+    /// environment, in `cwd` if given), stdout and stderr to `log`.
     pub fn spawn(
         &mut self,
         index: usize,
         program: &Path,
         args: &[String],
+        env: &[(String, String)],
+        cwd: Option<&Path>,
         log: &Path,
     ) -> std::io::Result<()> {
         let out = std::fs::File::create(log)?;
         let err = out.try_clone()?;
         let mut cmd = tokio::process::Command::new(program);
+        if let Some(dir) = cwd {
+            cmd.current_dir(dir);
+        }
         cmd.args(args)
+            .envs(env.iter().map(|(k, v)| (k, v)))
             .stdin(Stdio::null())
             .stdout(out)
             .stderr(err)

@@ -133,6 +133,9 @@ pub fn agent_summaries(series: &[Series], peak_torques: &[f64]) -> Vec<AgentSumm
             settle_time_1e3: summary::settle_time(&s.t, &s.att, 1e-3),
             settle_time_1e6: summary::settle_time(&s.t, &s.att, 1e-6),
             peak_torque,
+            late_stages: None,
+            max_lateness: None,
+            plugin: None,
         })
         .collect()
 }

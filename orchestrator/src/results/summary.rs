@@ -24,10 +24,20 @@ pub struct AgentSummary {
     pub settle_time_1e6: Option<f64>,
     /// Largest `‖τᵢ‖` applied at the start of any step, N·m.
     pub peak_torque: f64,
+    /// Real-time mode: stages the agent started more than one step late.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub late_stages: Option<u64>,
+    /// Real-time mode: the agent's largest lateness against the wall clock, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_lateness: Option<f64>,
+    /// The program that ran this agent, if it was a plug-in.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plugin: Option<String>,
 }
 
-/// Counters of one impaired directed link (links without impairments are
-/// ideal in lockstep and not listed).
+/// Counters of one directed link. Listed: impaired links, every link in
+/// real-time mode (measured), and any link on which the receiver refused
+/// invalid values; an unimpaired lockstep link is ideal and not listed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LinkSummary {
     /// Sender id (0 = leader).
@@ -44,6 +54,10 @@ pub struct LinkSummary {
     pub aoi_mean: f64,
     /// Largest age of information, s.
     pub aoi_max: f64,
+    /// Messages the receiver refused (non-finite values, or an attitude that
+    /// is not a rotation); it kept its previous value instead.
+    #[serde(default)]
+    pub rejected: u64,
 }
 
 /// The whole run.
@@ -73,8 +87,11 @@ pub struct Summary {
     pub max_final_att_err: f64,
     /// Per agent, ascending id.
     pub agents: Vec<AgentSummary>,
-    /// Per impaired link, by (from, to).
+    /// Per listed link, by (from, to).
     pub links: Vec<LinkSummary>,
+    /// Real-time factor (simulated s per wall s), `None` for lockstep.
+    #[serde(default)]
+    pub realtime: Option<f64>,
 }
 
 /// Time after which `err` stays below `threshold`: the sample after the last
@@ -122,9 +139,20 @@ impl Summary {
                 a.peak_torque
             );
         }
+        for l in &self.links {
+            let _ = writeln!(
+                s,
+                "link {:>3} → {:<3} sent {:>8} delivered {:>8} lost {:>7} rejected {:>5} AoI mean {:.3e} s max {:.3e} s",
+                l.from, l.to, l.sent, l.delivered, l.lost, l.rejected, l.aoi_mean, l.aoi_max
+            );
+        }
+        let mode = match self.realtime {
+            Some(f) => format!(" real-time ×{f}"),
+            None => String::new(),
+        };
         let _ = write!(
             s,
-            "{} run of {}: t = {} s of {} s ({} steps, {:.2} s wall){}",
+            "{}{mode} run of {}: t = {} s of {} s ({} steps, {:.2} s wall){}",
             self.engine,
             self.scenario,
             self.t_end,

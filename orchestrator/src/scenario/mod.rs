@@ -2,6 +2,7 @@
 //! validation and resolution into the model's network ([`resolve`]).
 
 pub mod overrides;
+pub mod plugin;
 pub mod report;
 pub mod resolve;
 pub mod schema;
@@ -116,7 +117,20 @@ pub fn load_str(file: &Path, text: &str, overrides: &[String]) -> Result<Loaded,
         serde_path_to_error::deserialize(toml::Value::Table(document.clone()))
             .map_err(|e| parse(format!("{}: {}", e.path(), e.inner())))?
     };
-    let resolved = resolve::resolve(&scenario).map_err(|issues| ScenarioError::Invalid {
+    let dir = match file.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+        _ => PathBuf::from("."),
+    };
+    let dir = std::path::absolute(&dir).unwrap_or(dir);
+    let resolved = match (resolve::resolve(&scenario), plugin::resolve(&scenario, &dir)) {
+        (Ok(r), Ok(plugins)) => Ok(resolve::Resolved { plugins, ..r }),
+        (Err(mut a), Err(b)) => {
+            a.extend(b);
+            Err(a)
+        }
+        (Err(a), Ok(_)) | (Ok(_), Err(a)) => Err(a),
+    }
+    .map_err(|issues| ScenarioError::Invalid {
         file: file.to_owned(),
         issues,
     })?;

@@ -49,6 +49,8 @@ pub struct Resolved {
     pub spectrum: Vec<f64>,
     /// Smallest eigenvalue of Appendix D's `F` (scheme 1 only).
     pub appendix_d_min_eig: Option<f64>,
+    /// Agents run by the user's own programs.
+    pub plugins: Vec<super::plugin::Plugin>,
 }
 
 #[derive(Default)]
@@ -737,6 +739,7 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         leader_links: links.keys().copied().collect(),
         spectrum,
         appendix_d_min_eig,
+        plugins: Vec::new(),
     })
 }
 

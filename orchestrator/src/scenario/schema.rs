@@ -275,6 +275,14 @@ pub struct AgentSpec {
     /// The observer's initial state (schemes 1–2).
     #[serde(default)]
     pub observer: Option<ObserverInit>,
+    /// A program of your own to run in place of the built-in agent (a
+    /// plug-in, PROTOCOL.md): program and arguments. It is started in the
+    /// scenario file's directory with `--config FILE` appended.
+    #[serde(default)]
+    pub command: Option<Vec<String>>,
+    /// Extra environment variables of the plug-in.
+    #[serde(default)]
+    pub env: Option<std::collections::BTreeMap<String, String>>,
 }
 
 /// `agent.observer`.

@@ -1,0 +1,86 @@
+//! Deterministic lockstep: at every exchange (n, s) a node publishes its
+//! stage state stamped (n, s), wakes its receivers, waits (bounded) until
+//! every input's message stamped (n, s) has arrived, then advances one stage.
+
+use super::ports::Ports;
+use super::{Inputs, NodeError, Orphan, Stepper, check_origin, port};
+use crate::wait::Waiter;
+use iceoryx2::prelude::*;
+use msgs::config::NodeConfig;
+use msgs::{StateMsg, TelemetryKind, TelemetryMsg};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Steps `cfg.steps` steps in lockstep; returns the `Done` report.
+pub(crate) fn run<S: Service, N: Stepper>(
+    ports: &Ports<S>,
+    cfg: &NodeConfig,
+    stepper: &mut N,
+    inputs: &mut Inputs,
+    shutdown: &AtomicBool,
+    orphan: &Orphan,
+) -> Result<TelemetryMsg, NodeError> {
+    let stage_timeout = Duration::from_secs_f64(cfg.stage_timeout);
+    let mut waiter = Waiter::new(cfg.wait);
+    let notify = waiter.receivers_may_block();
+    ports.report(stepper.sample(0))?;
+    for n in 0..cfg.steps {
+        if shutdown.load(Ordering::Relaxed) {
+            return Err(NodeError::Stopped(n));
+        }
+        if n % 256 == 0 {
+            orphan.check()?;
+        }
+        for s in 0..4u32 {
+            if cfg.coupling.exchanges_at(n, s as usize) {
+                ports.publish(StateMsg::new(cfg.id, n, s, &stepper.stage_exchange()), notify)?;
+                let deadline = Instant::now() + stage_timeout;
+                waiter.begin();
+                for k in 0..ports.inputs.len() {
+                    let msg = loop {
+                        // Take one message at a time: what stays in iceoryx2's
+                        // buffer holds a fast sender back (flow control).
+                        if let Some(sample) =
+                            ports.inputs[k].receive().map_err(port("state receive"))?
+                        {
+                            break *sample;
+                        }
+                        if waiter.polls() % 1024 == 1023 {
+                            orphan.check()?;
+                        }
+                        if waiter.wait(&ports.listener, deadline) {
+                            return Err(NodeError::InputTimeout {
+                                from: cfg.inputs[k],
+                                step: n,
+                                stage: s,
+                                waited: cfg.stage_timeout,
+                            });
+                        }
+                    };
+                    check_origin(&msg, cfg.inputs[k])?;
+                    if (msg.step, msg.stage) != (n, s) {
+                        return Err(NodeError::Protocol(format!(
+                            "node {} sent step {} stage {} where step {n} stage {s} was due",
+                            cfg.inputs[k], msg.step, msg.stage
+                        )));
+                    }
+                    // A refused value is like a lost message: keep what we had.
+                    if let Some(x) = inputs.accept(cfg, k, &msg) {
+                        stepper.receive(k, x);
+                    }
+                }
+            }
+            stepper.advance();
+        }
+        let done = n + 1;
+        if done % cfg.sample_every == 0 || done == cfg.steps {
+            ports.report(stepper.sample(done))?;
+        }
+    }
+    Ok(TelemetryMsg::bare(
+        cfg.id,
+        cfg.steps,
+        TelemetryKind::Done,
+        stepper.peak_torque(),
+    ))
+}

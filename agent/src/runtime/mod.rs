@@ -1,0 +1,310 @@
+//! The node loop shared by the agent and the leader processes.
+//!
+//! Protocol (ARCHITECTURE.md § step protocol, PROTOCOL.md):
+//! 1. open every port; wait (bounded) until every receiver of our state, the
+//!    orchestrator's telemetry subscriber and the sender of every input are
+//!    connected; report `Ready`; wait (bounded) for `Start`;
+//! 2. step, either in deterministic [`lockstep`] (the default) or free
+//!    against the wall clock ([`realtime`]);
+//! 3. report the counters of the incoming links, then `Done`, and wait
+//!    (bounded) for `Stop`.
+//!
+//! Every received state is checked ([`StateMsg::validated`]); an invalid
+//! one is refused, counted and reported, and the node keeps the value it had.
+
+mod lockstep;
+mod ports;
+mod realtime;
+
+use attitude::link::LinkStats;
+use attitude::network::Exchanged;
+use iceoryx2::node::Node;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use msgs::config::NodeConfig;
+use msgs::open::OpenError;
+use msgs::{ControlCommand, ControlMsg, PROTOCOL_VERSION, StateMsg, TelemetryKind, TelemetryMsg};
+use ports::Ports;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+use tracing::{debug, info, warn};
+
+/// A node's model, seen by the loop: the leader or an agent.
+pub trait Stepper {
+    /// State published at the current stage.
+    fn stage_exchange(&self) -> Exchanged;
+    /// Stores the value received from input `k` (order of `NodeConfig::inputs`).
+    fn receive(&mut self, k: usize, x: Exchanged);
+    /// Evaluates the current stage and moves on.
+    fn advance(&mut self);
+    /// Telemetry sample of the state at the start of the current step.
+    fn sample(&self, step: u64) -> TelemetryMsg;
+    /// Largest torque norm so far.
+    fn peak_torque(&self) -> f64;
+    /// Counters of the impaired incoming links: (sender id, stats).
+    fn link_stats(&self) -> Vec<(u32, LinkStats)> {
+        Vec::new()
+    }
+}
+
+/// Why a node stopped before completing the protocol.
+#[derive(Debug, Error)]
+pub enum NodeError {
+    /// A service could not be opened.
+    #[error(transparent)]
+    Open(#[from] OpenError),
+    /// A port could not be created or used.
+    #[error("iceoryx2 port: {0}")]
+    Port(String),
+    /// A bounded wait ran out.
+    #[error("timed out after {waited:.1} s waiting for {what}")]
+    Timeout {
+        /// What was awaited.
+        what: String,
+        /// How long, s.
+        waited: f64,
+    },
+    /// An input's state did not arrive in time.
+    #[error("timed out after {waited:.1} s waiting for node {from}'s state of step {step} stage {stage}")]
+    InputTimeout {
+        /// The silent node.
+        from: u32,
+        /// Step awaited.
+        step: u64,
+        /// Stage awaited.
+        stage: u32,
+        /// How long, s.
+        waited: f64,
+    },
+    /// A peer broke the protocol.
+    #[error("protocol violation: {0}")]
+    Protocol(String),
+    /// The process that started this node has exited.
+    #[error("the orchestrator (pid {0}) has exited")]
+    Orphaned(u32),
+    /// The orchestrator said stop, or the shutdown signal was raised, before the end.
+    #[error("stopped before the end (at step {0})")]
+    Stopped(u64),
+}
+
+pub(crate) fn port<E: std::fmt::Debug>(what: &str) -> impl FnOnce(E) -> NodeError + '_ {
+    move |e| NodeError::Port(format!("{what}: {e:?}"))
+}
+
+/// Runs node `cfg.id` to the end of the protocol.
+pub fn run<S: Service, N: Stepper>(
+    node: &Node<S>,
+    cfg: &NodeConfig,
+    stepper: &mut N,
+    shutdown: &AtomicBool,
+) -> Result<(), NodeError> {
+    let orphan = Orphan::new();
+    let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
+    let ports = Ports::open(node, cfg)?;
+    ports.await_connections(cfg)?;
+    ports.report(TelemetryMsg::bare(cfg.id, 0, TelemetryKind::Ready, 0.0))?;
+    info!(id = cfg.id, inputs = ?cfg.inputs, outputs = ?cfg.outputs, "ready");
+    let start = match wait_command(&ports.control, start_timeout, shutdown, &orphan)? {
+        Some((ControlCommand::Start, start)) => start,
+        _ => return Err(NodeError::Stopped(0)),
+    };
+    info!(realtime = ?cfg.realtime, "started");
+
+    let mut inputs = Inputs::new(cfg);
+    let stepped = match cfg.realtime {
+        None => lockstep::run(&ports, cfg, stepper, &mut inputs, shutdown, &orphan),
+        Some(factor) => realtime::run(
+            &ports,
+            cfg,
+            stepper,
+            &mut inputs,
+            realtime::Clock::new(start, factor, cfg.dt),
+            shutdown,
+            &orphan,
+        ),
+    };
+    let done = match stepped {
+        Err(NodeError::InputTimeout { from, .. }) => {
+            // Tell the orchestrator whom we waited for, so that it can name
+            // the node that hangs (best effort: we are failing anyway).
+            let _ = ports.report(TelemetryMsg::bare(
+                cfg.id,
+                u64::from(from),
+                TelemetryKind::Failed,
+                0.0,
+            ));
+            return stepped.map(|_| ());
+        }
+        other => other?,
+    };
+    for (from, st) in inputs.stats(cfg, stepper.link_stats()) {
+        ports.report(TelemetryMsg::link_stats(cfg.id, from, &st))?;
+    }
+    ports.report(done)?;
+    info!(steps = cfg.steps, peak_rss_kb = peak_rss_kb(), "done");
+    // Other nodes may still be stepping: wait for Stop as long as the
+    // orchestrator lives (bounded by STOP_TIMEOUT all the same).
+    match wait_command(&ports.control, STOP_TIMEOUT, shutdown, &orphan)? {
+        Some((ControlCommand::Stop, _)) | None => Ok(()),
+        Some((ControlCommand::Start, _)) => Err(NodeError::Protocol("second Start".into())),
+    }
+}
+
+/// What the node knows of its incoming links beyond the model: messages
+/// refused as invalid and, in real-time mode, the measured counters.
+#[derive(Debug)]
+pub(crate) struct Inputs {
+    /// Per input: messages refused.
+    rejected: Vec<u64>,
+    /// Per input: counters measured by the runtime (real-time mode).
+    measured: Vec<LinkStats>,
+    /// Whether `measured` is reported.
+    report_measured: bool,
+}
+
+impl Inputs {
+    fn new(cfg: &NodeConfig) -> Self {
+        Self {
+            rejected: vec![0; cfg.inputs.len()],
+            measured: vec![LinkStats::default(); cfg.inputs.len()],
+            report_measured: cfg.realtime.is_some(),
+        }
+    }
+
+    /// Checks message `msg` of input `k`: `Some(value)` if it can be used.
+    pub(crate) fn accept(&mut self, cfg: &NodeConfig, k: usize, msg: &StateMsg) -> Option<Exchanged> {
+        match msg.validated() {
+            Ok(x) => Some(x),
+            Err(why) => {
+                if self.rejected[k] == 0 {
+                    warn!(
+                        from = cfg.inputs[k],
+                        step = msg.step,
+                        stage = msg.stage,
+                        "refused a state: {why} (further refusals are only counted)"
+                    );
+                }
+                self.rejected[k] += 1;
+                None
+            }
+        }
+    }
+
+    /// The counters to report: (sender id, stats) for every input that is
+    /// impaired, measured or has refused messages.
+    fn stats(&self, cfg: &NodeConfig, model: Vec<(u32, LinkStats)>) -> Vec<(u32, LinkStats)> {
+        cfg.inputs
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &from)| {
+                let modelled = model.iter().find(|(id, _)| *id == from).map(|(_, s)| *s);
+                let base = match (modelled, self.report_measured) {
+                    (Some(s), _) => Some(s),
+                    (None, true) => Some(self.measured[k]),
+                    (None, false) if self.rejected[k] > 0 => Some(LinkStats::default()),
+                    (None, false) => None,
+                };
+                base.map(|s| {
+                    (
+                        from,
+                        LinkStats {
+                            rejected: self.rejected[k],
+                            ..s
+                        },
+                    )
+                })
+            })
+            .collect()
+    }
+}
+
+/// Longest wait for `Stop` after the last step.
+const STOP_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// Peak resident set size of this process (VmHWM), kB; 0 if unknown.
+#[must_use]
+pub fn peak_rss_kb() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse().ok())
+        })
+        .unwrap_or(0)
+}
+
+/// Detects that the process that started us (the orchestrator) is gone, so
+/// that a node never outlives its run.
+#[derive(Debug)]
+pub(crate) struct Orphan {
+    parent: u32,
+}
+
+impl Orphan {
+    fn new() -> Self {
+        Self {
+            parent: std::os::unix::process::parent_id(),
+        }
+    }
+
+    pub(crate) fn check(&self) -> Result<(), NodeError> {
+        if std::os::unix::process::parent_id() != self.parent {
+            return Err(NodeError::Orphaned(self.parent));
+        }
+        Ok(())
+    }
+}
+
+/// The message must be from `sender` and speak our version.
+pub(crate) fn check_origin(m: &StateMsg, sender: u32) -> Result<(), NodeError> {
+    if m.version != PROTOCOL_VERSION {
+        return Err(NodeError::Protocol(format!(
+            "node {sender} speaks protocol version {}, this node {PROTOCOL_VERSION}",
+            m.version
+        )));
+    }
+    if m.sender != sender {
+        return Err(NodeError::Protocol(format!(
+            "message on node {sender}'s state service claims sender {}",
+            m.sender
+        )));
+    }
+    Ok(())
+}
+
+/// Waits (polling every millisecond, bounded) for a control command; returns
+/// it with its `start_unix_ns`.
+fn wait_command<S: Service>(
+    control: &Subscriber<S, ControlMsg, ()>,
+    timeout: Duration,
+    shutdown: &AtomicBool,
+    orphan: &Orphan,
+) -> Result<Option<(ControlCommand, u64)>, NodeError> {
+    let deadline = Instant::now() + timeout;
+    loop {
+        if let Some(sample) = control.receive().map_err(port("control receive"))? {
+            if sample.version != PROTOCOL_VERSION {
+                return Err(NodeError::Protocol(format!(
+                    "orchestrator speaks protocol version {}, this node {PROTOCOL_VERSION}",
+                    sample.version
+                )));
+            }
+            debug!(command = sample.command, "control");
+            return Ok(sample.command().map(|c| (c, sample.start_unix_ns)));
+        }
+        if shutdown.load(Ordering::Relaxed) {
+            return Ok(None);
+        }
+        orphan.check()?;
+        if Instant::now() > deadline {
+            return Err(NodeError::Timeout {
+                what: "a command from the orchestrator".into(),
+                waited: timeout.as_secs_f64(),
+            });
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+}

@@ -1,0 +1,186 @@
+//! Every iceoryx2 port a node uses, and the readiness barrier.
+
+use super::{NodeError, port};
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSub;
+use msgs::config::NodeConfig;
+use msgs::open;
+use msgs::{ControlMsg, StateMsg, TelemetryMsg};
+use std::time::{Duration, Instant};
+
+/// A node's ports.
+pub(crate) struct Ports<S: Service> {
+    own: PubSub<S, StateMsg, ()>,
+    /// Publishes our state.
+    pub publisher: Publisher<S, StateMsg, ()>,
+    /// Our wake event (inputs have news).
+    pub listener: Listener<S>,
+    tele: PubSub<S, TelemetryMsg, ()>,
+    tele_pub: Publisher<S, TelemetryMsg, ()>,
+    orch_notifier: Notifier<S>,
+    /// Orchestrator commands.
+    pub control: Subscriber<S, ControlMsg, ()>,
+    /// One subscriber per input, in `NodeConfig::inputs` order.
+    pub inputs: Vec<Subscriber<S, StateMsg, ()>>,
+    input_services: Vec<PubSub<S, StateMsg, ()>>,
+    /// The wake events of our receivers.
+    pub notifiers: Vec<Notifier<S>>,
+}
+
+impl<S: Service> Ports<S> {
+    /// Opens every port of node `cfg.id`. In lockstep a full receiver holds
+    /// our state back (flow control, bounded by the stage timeout); in
+    /// real-time mode nothing waits, so a full receiver misses the message.
+    pub fn open(node: &Node<S>, cfg: &NodeConfig) -> Result<Self, NodeError> {
+        let (run, l, id) = (cfg.run.as_str(), &cfg.limits, cfg.id);
+        let stage_timeout = Duration::from_secs_f64(cfg.stage_timeout);
+        let own = open::state(node, run, id, l)?;
+        let publisher = match cfg.realtime {
+            None => own
+                .publisher_builder()
+                .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+                .set_backpressure_handler(retry_until(stage_timeout)),
+            Some(_) => own
+                .publisher_builder()
+                .backpressure_strategy(BackpressureStrategy::DiscardData),
+        }
+        .create()
+        .map_err(port("state publisher"))?;
+        let listener = open::wake(node, run, id, l)?
+            .listener_builder()
+            .create()
+            .map_err(port("wake listener"))?;
+        let tele = open::telemetry(node, run, id, l)?;
+        let tele_pub = tele
+            .publisher_builder()
+            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+            .set_backpressure_handler(retry_until(stage_timeout))
+            .create()
+            .map_err(port("telemetry publisher"))?;
+        let orch_notifier = open::orchestrator_wake(node, run, l)?
+            .notifier_builder()
+            .create()
+            .map_err(port("orchestrator notifier"))?;
+        let control = open::control(node, run, l)?
+            .subscriber_builder()
+            .create()
+            .map_err(port("control subscriber"))?;
+        let mut inputs = Vec::new();
+        let mut input_services = Vec::new();
+        for &j in &cfg.inputs {
+            let svc = open::state(node, run, j, l)?;
+            inputs.push(
+                svc.subscriber_builder()
+                    .buffer_size(l.state_buffer)
+                    .create()
+                    .map_err(port("state subscriber"))?,
+            );
+            input_services.push(svc);
+        }
+        let notifiers = cfg
+            .outputs
+            .iter()
+            .map(|&j| {
+                open::wake(node, run, j, l)?
+                    .notifier_builder()
+                    .create()
+                    .map_err(port("wake notifier"))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self {
+            own,
+            publisher,
+            listener,
+            tele,
+            tele_pub,
+            orch_notifier,
+            control,
+            inputs,
+            input_services,
+            notifiers,
+        })
+    }
+
+    /// Readiness barrier: waits (bounded by the start timeout) until every
+    /// edge is connected in both directions.
+    pub fn await_connections(&self, cfg: &NodeConfig) -> Result<(), NodeError> {
+        let ready_by = Instant::now() + Duration::from_secs_f64(cfg.start_timeout);
+        loop {
+            let subs_ok = self.own.dynamic_config().number_of_subscribers() >= cfg.outputs.len()
+                && self.tele.dynamic_config().number_of_subscribers() >= 1;
+            let missing: Vec<u32> = cfg
+                .inputs
+                .iter()
+                .zip(&self.input_services)
+                .filter(|(_, s)| s.dynamic_config().number_of_publishers() < 1)
+                .map(|(&j, _)| j)
+                .collect();
+            if missing.is_empty() {
+                // iceoryx2 attaches a subscriber to a publisher lazily; attach
+                // now, so that nothing a sender publishes before our first
+                // receive() can be dropped.
+                for sub in &self.inputs {
+                    sub.update_connections().map_err(port("connect input"))?;
+                }
+            }
+            if subs_ok && missing.is_empty() {
+                return Ok(());
+            }
+            if Instant::now() > ready_by {
+                return Err(NodeError::Timeout {
+                    what: format!(
+                        "connections (receivers {}/{}, orchestrator {}, inputs without a publisher {:?})",
+                        self.own.dynamic_config().number_of_subscribers(),
+                        cfg.outputs.len(),
+                        self.tele.dynamic_config().number_of_subscribers(),
+                        missing
+                    ),
+                    waited: cfg.start_timeout,
+                });
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+
+    /// Sends a telemetry message and wakes the orchestrator.
+    pub fn report(&self, m: TelemetryMsg) -> Result<(), NodeError> {
+        self.tele_pub
+            .send_copy(m)
+            .map_err(port("telemetry send"))?;
+        let _ = self.orch_notifier.notify();
+        Ok(())
+    }
+
+    /// Publishes our state and, if `notify`, wakes every receiver.
+    pub fn publish(&self, m: StateMsg, notify: bool) -> Result<(), NodeError> {
+        self.publisher.send_copy(m).map_err(port("state send"))?;
+        if notify {
+            for nt in &self.notifiers {
+                let _ = nt.notify();
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A backpressure handler: yield and retry until `timeout`, then give up on
+/// that receiver and fail the send (so nothing hangs).
+fn retry_until(
+    timeout: Duration,
+) -> impl Fn(&iceoryx2::port::BackpressureInfo) -> iceoryx2::port::BackpressureAction + Send + 'static
+{
+    move |info| {
+        if info.elapsed_time > timeout {
+            iceoryx2::port::BackpressureAction::DiscardDataAndFail
+        } else {
+            std::thread::yield_now();
+            iceoryx2::port::BackpressureAction::Retry
+        }
+    }
+}
