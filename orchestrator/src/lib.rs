@@ -6,7 +6,9 @@
 //! - [`run`]: engines and the run driver (progress, interruption).
 //! - [`results`]: `errors.csv`, `summary.json`, `errors.svg`, atomic output.
 //! - [`generate`]: generated scenarios (random trees).
+//! - [`conform`]: the conformance check of a plug-in agent program.
 
+pub mod conform;
 pub mod generate;
 pub mod processes;
 pub mod results;

@@ -99,6 +99,33 @@ enum Command {
         #[arg(long)]
         quantum: Option<f64>,
     },
+    /// Check a plug-in agent program against PROTOCOL.md: attsync plays its
+    /// orchestrator, leader and neighbours in lockstep and reports each rule.
+    /// Exit code 0 only if every rule passes.
+    Conform {
+        /// Neighbourhood scenario [default: built-in: agent 2 between agents 1
+        /// and 3, hearing the leader, observerless scheme, 0.2 s].
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// The candidate's agent id in the neighbourhood.
+        #[arg(long, default_value_t = 2)]
+        agent: u32,
+        /// Override a field of the neighbourhood: key.path=value (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Longest wait for one of the candidate's states, s.
+        #[arg(long, default_value_t = 5.0)]
+        stage_timeout: f64,
+        /// Longest wait for the candidate to connect, s.
+        #[arg(long, default_value_t = 20.0)]
+        start_timeout: f64,
+        /// Where the candidate's output goes [default: a file in the temp directory].
+        #[arg(long)]
+        log: Option<PathBuf>,
+        /// The candidate program and its arguments (after `--`).
+        #[arg(last = true, required = true, value_name = "COMMAND")]
+        command: Vec<String>,
+    },
     /// Convert a run's states.bin (the full state trajectory).
     Export {
         /// The states.bin file of a run.
@@ -193,6 +220,35 @@ fn main() -> ExitCode {
 
 fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
+        Command::Conform {
+            scenario,
+            agent,
+            set,
+            stage_timeout,
+            start_timeout,
+            log,
+            command,
+        } => {
+            let log = log.unwrap_or_else(|| {
+                std::env::temp_dir().join(format!("attsync-conform-{}.log", std::process::id()))
+            });
+            let opts = attsync::conform::ConformOptions {
+                command,
+                scenario,
+                set,
+                agent,
+                stage_timeout,
+                start_timeout,
+                log,
+            };
+            let report = attsync::conform::conform(&opts)?;
+            println!("{}", report.table());
+            Ok(if report.passed() {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            })
+        }
         Command::Check { scenario, set } => {
             let loaded = scenario::load(&scenario, &set)?;
             print!("{}", attsync::scenario::report::describe(&loaded));

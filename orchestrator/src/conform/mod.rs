@@ -1,0 +1,68 @@
+//! `attsync conform -- <command…>`: runs a candidate agent program against a
+//! scripted neighbourhood (attsync plays the orchestrator, the leader and
+//! the candidate's neighbours, in lockstep) and checks it against each rule
+//! of PROTOCOL.md, with the reason for every failure.
+//!
+//! The neighbourhood is a scenario (by default [`NEIGHBOURHOOD`]: agent 2
+//! between agents 1 and 3, hearing the leader); every node but the
+//! candidate runs in-process on attsync's own model, fed with what the
+//! candidate publishes, so the candidate is exercised in a real closed loop.
+
+mod harness;
+mod rules;
+
+pub use rules::{Report, Rule, RuleId, Verdict};
+
+use crate::scenario::{self, Loaded};
+use std::path::PathBuf;
+
+/// The built-in neighbourhood.
+pub const NEIGHBOURHOOD: &str = include_str!("neighbourhood.toml");
+
+/// What to check and how.
+#[derive(Debug, Clone)]
+pub struct ConformOptions {
+    /// The candidate: program and arguments (`--config FILE` is appended).
+    pub command: Vec<String>,
+    /// Neighbourhood scenario (`None`: [`NEIGHBOURHOOD`]).
+    pub scenario: Option<PathBuf>,
+    /// `--set` overrides of the neighbourhood.
+    pub set: Vec<String>,
+    /// The candidate's agent id in the neighbourhood.
+    pub agent: u32,
+    /// Longest wait for one of the candidate's messages, s.
+    pub stage_timeout: f64,
+    /// Longest wait for the candidate to connect, s.
+    pub start_timeout: f64,
+    /// Where the candidate's output goes.
+    pub log: PathBuf,
+}
+
+/// The neighbourhood of `opts`.
+pub fn neighbourhood(opts: &ConformOptions) -> Result<Loaded, scenario::ScenarioError> {
+    match &opts.scenario {
+        Some(file) => scenario::load(file, &opts.set),
+        None => scenario::load_str(
+            std::path::Path::new("<built-in conform neighbourhood>"),
+            NEIGHBOURHOOD,
+            &opts.set,
+        ),
+    }
+}
+
+/// Runs every check; errors only if the harness itself cannot run.
+pub fn conform(opts: &ConformOptions) -> anyhow::Result<Report> {
+    let loaded = neighbourhood(opts)?;
+    let net = &loaded.resolved.network;
+    let Some(index) = net.index_of(opts.agent) else {
+        anyhow::bail!(
+            "agent {} is not in the neighbourhood {}",
+            opts.agent,
+            loaded.file.display()
+        );
+    };
+    let mut report = Report::new(opts.log.clone());
+    harness::version_probe(net, index, opts, &mut report)?;
+    harness::session(net, index, opts, &mut report)?;
+    Ok(report)
+}
