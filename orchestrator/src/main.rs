@@ -30,6 +30,10 @@ enum Command {
         /// Override a field: key.path=value (repeatable), e.g. simulation.duration=10.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
+        /// Print instead the JSON configuration node ID (0 = leader) would
+        /// receive (PROTOCOL.md; `run` and `iox_root` are placeholders).
+        #[arg(long, value_name = "ID")]
+        node_config: Option<u32>,
     },
     /// Run a scenario and write its results.
     Run {
@@ -249,9 +253,35 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 ExitCode::from(1)
             })
         }
-        Command::Check { scenario, set } => {
+        Command::Check {
+            scenario,
+            set,
+            node_config,
+        } => {
             let loaded = scenario::load(&scenario, &set)?;
-            print!("{}", attsync::scenario::report::describe(&loaded));
+            let Some(id) = node_config else {
+                print!("{}", attsync::scenario::report::describe(&loaded));
+                return Ok(ExitCode::SUCCESS);
+            };
+            let net = &loaded.resolved.network;
+            let index = match id {
+                0 => 0,
+                _ => match net.index_of(id) {
+                    Some(i) => i + 1,
+                    None => anyhow::bail!("{}: no node {id}", scenario.display()),
+                },
+            };
+            let cfg = attsync::processes::node_configs(
+                net,
+                "RUN",
+                std::path::Path::new("/tmp/attsync-iox2/RUN"),
+                &ProcessOptions::default(),
+            )
+            .swap_remove(index);
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&cfg).expect("a config serialises")
+            );
             Ok(ExitCode::SUCCESS)
         }
         Command::Run {

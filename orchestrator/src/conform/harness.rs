@@ -118,7 +118,7 @@ pub(super) fn version_probe(
         Some(st) => report.fail(
             RuleId::Version,
             format!(
-                "given protocol_version {} it {} instead of refusing",
+                "given protocol_version {} it ended with {} instead of refusing",
                 cfg.protocol_version,
                 describe(&st)
             ),
@@ -472,7 +472,7 @@ fn drive(
             };
             report.fail(
                 RuleId::Connects,
-                format!("it {} before reporting Ready{hint}; its last output:\n{tail}", describe(&st)),
+                format!("it ended ({}) before reporting Ready{hint}; its last output:\n{tail}", describe(&st)),
             );
             skip_rest(report, "it never connected");
             return Ok(());
@@ -531,7 +531,7 @@ fn drive(
                 tcheck.drain(tele, id, cfg.steps);
                 if let Ok(Some(st)) = child.try_wait() {
                     let why = format!(
-                        "it {} at step {n} stage {s}; its last output:\n{}",
+                        "it ended ({}) at step {n} stage {s}; its last output:\n{}",
                         describe(&st),
                         log_tail(opts)
                     );
@@ -643,7 +643,7 @@ fn drive(
     }
     match wait_exit(child, EXIT_TIMEOUT) {
         Some(st) if st.success() => report.pass(RuleId::Stops),
-        Some(st) => report.fail(RuleId::Stops, format!("told to stop, it {}", describe(&st))),
+        Some(st) => report.fail(RuleId::Stops, format!("told to stop, it ended with {}", describe(&st))),
         None => {
             report.fail(
                 RuleId::Stops,
