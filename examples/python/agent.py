@@ -44,7 +44,7 @@ ADAPTIVE_YIELDS = int(os.environ.get("ATTSYNC_PY_YIELDS", "20"))
 BLOCK_SLICE_MS = 1  # longest single sleep on the wake event
 
 # Telemetry kinds and control commands (msgs/src/payload.rs).
-READY, SAMPLE, DONE, LINK_STATS = 1, 2, 3, 4
+READY, SAMPLE, DONE, LINK_STATS, FAILED = 1, 2, 3, 4, 5
 START, STOP = 1, 2
 
 PROG = "attsync python agent"
@@ -604,7 +604,8 @@ def wait_command(ports, timeout, orphan):
 # --------------------------------------------------------------------------
 
 def lockstep(ports, cfg, agent, orphan):
-    """Steps `steps` steps in lockstep; returns the rejected-message counts."""
+    """Steps `steps` steps in lockstep (agent/src/runtime/lockstep.rs).
+    Returns the messages refused per input and waiting statistics."""
     iox2 = ports.iox2
     node_id, steps = cfg["id"], int(cfg["steps"])
     sample_every, coupling = int(cfg["sample_every"]), cfg["coupling"]
@@ -612,15 +613,13 @@ def lockstep(ports, cfg, agent, orphan):
     inputs_ids = list(cfg["inputs"])
     stage_timeout = float(cfg["stage_timeout"])
     strategy = cfg.get("wait", "adaptive")
-    # Peers sleep on their wake event only with these strategies, and only
-    # then do senders notify (agent/src/wait.rs receivers_may_block).
-    notify = strategy in ("block", "adaptive")
+    # Polls between sleeps: -1 never sleeps (spin and yield both call
+    # sched_yield here: a spinning Python process would starve its peers).
     yields = {"spin": -1, "yield": -1, "block": 0}.get(strategy, ADAPTIVE_YIELDS)
     subs = ports.inputs
     listener, notifiers, publisher = ports.listener, ports.notifiers, ports.publisher
     slice_ = iox2.Duration.from_millis(BLOCK_SLICE_MS)
     rejected = [0] * len(subs)
-    stats = {"yields": 0, "sleeps": 0, "wait_s": 0.0}
     n_yields = n_sleeps = 0
     waited = 0.0
     string_at, memmove, monotonic = ctypes.string_at, ctypes.memmove, time.monotonic
@@ -640,12 +639,13 @@ def lockstep(ports, cfg, agent, orphan):
                 loan = publisher.loan_uninit()
                 memmove(loan.payload_ptr, msg, ssize)
                 loan.assume_init().send()
-                if notify:
-                    for nt in notifiers:
-                        try:
-                            nt.notify()
-                        except Exception:
-                            pass
+                # Wake every receiver (PROTOCOL.md § 6; attsync's own nodes
+                # skip it when every node busy-polls, with --wait spin|yield).
+                for nt in notifiers:
+                    try:
+                        nt.notify()
+                    except Exception:
+                        pass
                 deadline = None
                 polls = 0
                 t_wait = None
@@ -668,6 +668,13 @@ def lockstep(ports, cfg, agent, orphan):
                             n_sleeps += 1
                         # The clock every poll once sleeping, else every 64 polls.
                         if (0 <= yields < polls or polls % 64 == 0) and monotonic() > deadline:
+                            # Failed names the silent input for the orchestrator.
+                            try:
+                                ports.report(TELEMETRY.pack(PROTOCOL_VERSION, node_id,
+                                                            inputs_ids[k], FAILED, 0,
+                                                            *([0.0] * 28)))
+                            except Exception:
+                                pass
                             raise NodeError(
                                 f"timed out after {stage_timeout:.1f} s waiting for node "
                                 f"{inputs_ids[k]}'s state of step {n} stage {s}")
@@ -690,8 +697,7 @@ def lockstep(ports, cfg, agent, orphan):
         done = n + 1
         if done % sample_every == 0 or done == steps:
             ports.report(agent.sample(node_id, done))
-    stats.update(yields=n_yields, sleeps=n_sleeps, wait_s=waited)
-    return rejected, stats
+    return rejected, {"yields": n_yields, "sleeps": n_sleeps, "wait_s": waited}
 
 
 def check_message(m, sender, n, s):
@@ -739,8 +745,26 @@ def why_invalid(m):
             f"{orthogonality_defect(r):.3e}, or det R <= 0)")
 
 
+def import_iceoryx2():
+    """The iceoryx2 binding, version 0.10 (the wire format of the Rust side)."""
+    try:
+        import iceoryx2 as iox2
+    except ImportError as e:
+        raise NodeError(f"cannot import the Python package iceoryx2 ({e}): install it with "
+                        "`python3 -m pip install -r examples/python/requirements.txt`", 2) from e
+    try:
+        from importlib.metadata import version
+        found = version("iceoryx2")
+    except Exception:
+        found = None
+    if found is not None and not found.startswith("0.10."):
+        raise NodeError(f"iceoryx2 {found} is installed, but attsync speaks iceoryx2 0.10 "
+                        "(`python3 -m pip install iceoryx2==0.10.0`)", 2)
+    return iox2
+
+
 def run(cfg):
-    import iceoryx2 as iox2
+    iox2 = import_iceoryx2()
 
     iox2.set_log_level(iox2.LogLevel.Error)  # else a "no config file" warning
     node_id = cfg["id"]
@@ -767,7 +791,7 @@ def run(cfg):
         for k, count in enumerate(rejected):
             if count:
                 fields = [0.0] * 28
-                fields[27 - 4] = float(count)  # s_hat[0]
+                fields[24] = float(count)  # s_hat[0] (r 0-8, w 9-11, r_hat 12-20, w_hat 21-23)
                 ports.report(TELEMETRY.pack(PROTOCOL_VERSION, node_id, cfg["inputs"][k],
                                             LINK_STATS, 0, *fields))
         done = [0.0] * 28
@@ -795,6 +819,10 @@ def main(argv):
         return e.code
     except KeyboardInterrupt:
         return 130
+    except Exception:  # an iceoryx2 error or a bug: say where
+        import traceback
+        log("ERROR " + traceback.format_exc().rstrip().replace("\n", "\n    "))
+        return 1
     return 0
 
 

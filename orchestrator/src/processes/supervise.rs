@@ -113,13 +113,17 @@ impl Supervisor {
                     return;
                 }
             };
+            let pgid = child.id();
             let status = tokio::select! {
                 s = child.wait() => s,
                 _ = async { let _ = kill.wait_for(|k| *k).await.map(|_| ()); } => {
                     let _ = child.start_kill();
+                    kill_group(pgid);
                     child.wait().await
                 }
             };
+            // Whatever the node started (a plug-in's own children) ends with it.
+            kill_group(pgid);
             let _ = tx.send(Exit {
                 index,
                 status: status.map_err(|e| e.to_string()),
@@ -177,6 +181,16 @@ impl Drop for Supervisor {
             self.kill_all();
             let _ = self.wait_all(Duration::from_secs(5));
         }
+    }
+}
+
+/// SIGKILL to the process group led by `pgid` (each node leads its own).
+fn kill_group(pgid: Option<u32>) {
+    if let Some(pid) = pgid.and_then(|p| i32::try_from(p).ok()) {
+        let _ = nix::sys::signal::killpg(
+            nix::unistd::Pid::from_raw(pid),
+            nix::sys::signal::Signal::SIGKILL,
+        );
     }
 }
 
