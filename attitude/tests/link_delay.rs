@@ -239,7 +239,10 @@ fn lost_message_keeps_the_last_value() {
                 d => panic!("{d} messages delivered at one slot with a constant delay"),
             }
         }
-        assert!(kept > 1000 && replaced > 1000, "{kept} kept, {replaced} replaced");
+        assert!(
+            kept > 1000 && replaced > 1000,
+            "{kept} kept, {replaced} replaced"
+        );
         let st = link.stats();
         assert_eq!(st.sent, 8000);
         // Lost messages are counted when offered; at most the last k steps'
@@ -415,7 +418,12 @@ fn jitter_never_lets_an_older_message_replace_a_newer_one() {
             // Never fresher than the constant delay allows; never staler than
             // delay + jitter (every message is delivered by then).
             if x.n >= delay {
-                assert!(held <= (x.n - delay, x.s), "slot ({}, {}): {held:?}", x.n, x.s);
+                assert!(
+                    held <= (x.n - delay, x.s),
+                    "slot ({}, {}): {held:?}",
+                    x.n,
+                    x.s
+                );
             }
             if x.n >= delay + jitter {
                 assert!(
@@ -457,7 +465,10 @@ fn leader() -> (Matrix3<f64>, LeaderState) {
     let c = std::f64::consts::FRAC_1_SQRT_2;
     let p = Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.0, -c, 0.0, c, 0.0);
     let state = LeaderState {
-        r0: rot(0.8 * std::f64::consts::PI, &Vector3::new(1.0, 4.0, 2.0).normalize()),
+        r0: rot(
+            0.8 * std::f64::consts::PI,
+            &Vector3::new(1.0, 4.0, 2.0).normalize(),
+        ),
         w0: Vector3::new(1.0, 2.0, 0.0),
         s0: Vector3::new(1.0, 1.0, 0.0),
     };
@@ -476,7 +487,10 @@ fn scheme(observerless: bool) -> Scheme {
                 k_w: 14.0,
                 k_sigma: 12.0,
             },
-            control: ControlGains { k_r: 8.0, k_w: 13.0 },
+            control: ControlGains {
+                k_r: 8.0,
+                k_w: 13.0,
+            },
         }
     }
 }
@@ -546,11 +560,7 @@ fn network(observerless: bool, links: Links, steps: u64) -> Network {
                 vec![nb(2, a12, links.l21)],
                 Some((diag(6.0, 7.0, 8.0), links.l01)),
             ),
-            agent(
-                2,
-                vec![nb(1, a12, links.l12), nb(3, a23, links.l32)],
-                None,
-            ),
+            agent(2, vec![nb(1, a12, links.l12), nb(3, a23, links.l32)], None),
             agent(3, vec![nb(2, a23, links.l23)], None),
         ],
         p,
@@ -562,8 +572,11 @@ fn network(observerless: bool, links: Links, steps: u64) -> Network {
     }
 }
 
+/// Every agent's state at every step, as bit patterns.
+type Trajectory = Vec<Vec<Vec<u64>>>;
+
 /// States of every agent after every step, as bit patterns.
-fn run_engine(net: &Network) -> (Vec<Vec<Vec<u64>>>, Vec<Vec<(u32, LinkStats)>>) {
+fn run_engine(net: &Network) -> (Trajectory, Vec<Vec<(u32, LinkStats)>>) {
     let mut engine = InProcess::new(net);
     let mut out = Vec::new();
     engine.run(|snap| {
@@ -587,7 +600,13 @@ fn bits(x: &AgentState) -> Vec<u64> {
 /// What a receiver uses at slot (n, s) of a link that only delays by whole
 /// steps and carries every `period`-th step's stage 0: computed from the
 /// sender's published history, nothing else.
-fn delayed(hist: &[[Exchanged; 4]], n: u64, s: usize, delay: u64, period: Option<u64>) -> Exchanged {
+fn delayed(
+    hist: &[[Exchanged; 4]],
+    n: u64,
+    s: usize,
+    delay: u64,
+    period: Option<u64>,
+) -> Exchanged {
     if n < delay {
         return hist[0][0]; // the sender's initial state
     }
@@ -605,7 +624,7 @@ fn delay_of(l: Option<LinkModel>) -> (u64, Option<u64>) {
 /// The method of steps by hand: every node over ideal links, the test
 /// feeding each receiver the value its link should deliver, from plain
 /// histories of what every node published at every stage.
-fn method_of_steps(observerless: bool, links: Links, steps: u64) -> Vec<Vec<Vec<u64>>> {
+fn method_of_steps(observerless: bool, links: Links, steps: u64) -> Trajectory {
     use attitude::agent::Agent;
     let net = network(observerless, Links::ideal(), steps);
     let mut lead = Leader::new(net.p, net.leader, DT);

@@ -156,8 +156,9 @@ pub enum TelemetryKind {
     /// of information over evaluated stages (s), largest age (s), stages
     /// evaluated], `s_hat[0]` = messages rejected as invalid.
     LinkStats = 4,
-    /// The node gives up because an input's state did not arrive in time:
-    /// `step` = that input's node id. Sent just before the node exits.
+    /// The node gives up while stepping, just before it exits: `step` = the
+    /// id of the input whose state did not arrive in time, or `u64::MAX`
+    /// for any other reason (e.g. a receiver that stopped reading).
     Failed = 5,
 }
 

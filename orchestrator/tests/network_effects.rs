@@ -523,9 +523,7 @@ fn sweep_network_delay_with_margin() {
             .iter()
             .map(|a| a["settle_time_1e-3"].as_f64())
             .collect();
-        let latest = settle
-            .iter()
-            .try_fold(0.0_f64, |m, t| t.map(|t| m.max(t)));
+        let latest = settle.iter().try_fold(0.0_f64, |m, t| t.map(|t| m.max(t)));
         let t = field(&header, r, "time_to_1e-3");
         match latest {
             Some(x) => assert_eq!(t.parse::<f64>().ok(), Some(x), "{r:?}"),

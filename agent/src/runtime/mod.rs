@@ -125,18 +125,18 @@ pub fn run<S: Service, N: Stepper>(
         ),
     };
     let done = match stepped {
-        Err(NodeError::InputTimeout { from, .. }) => {
-            // Tell the orchestrator whom we waited for, so that it can name
-            // the node that hangs (best effort: we are failing anyway).
-            let _ = ports.report(TelemetryMsg::bare(
-                cfg.id,
-                u64::from(from),
-                TelemetryKind::Failed,
-                0.0,
-            ));
-            return stepped.map(|_| ());
+        Ok(done) => done,
+        Err(e) => {
+            // Tell the orchestrator whom we waited for (or that it was
+            // something else), so that it can name the node that hangs
+            // (best effort: we are failing anyway).
+            let whom = match e {
+                NodeError::InputTimeout { from, .. } => u64::from(from),
+                _ => u64::MAX,
+            };
+            let _ = ports.report(TelemetryMsg::bare(cfg.id, whom, TelemetryKind::Failed, 0.0));
+            return Err(e);
         }
-        other => other?,
     };
     for (from, st) in inputs.stats(cfg, stepper.link_stats()) {
         ports.report(TelemetryMsg::link_stats(cfg.id, from, &st))?;

@@ -20,13 +20,29 @@ use std::path::Path;
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-/// The exchange at which the neighbourhood holds its inputs back, to see
-/// whether the candidate advances without them.
-const WITHHOLD_AT: (u64, u32) = (5, 1);
+/// From this step on, the neighbourhood holds its inputs back at the next
+/// exchange that has a successor, to see whether the candidate advances
+/// without them.
+const WITHHOLD_FROM: u64 = 5;
 /// How long the inputs are held back.
 const WITHHOLD_FOR: Duration = Duration::from_millis(300);
-/// The exchange at which the first input carries a NaN.
-const NAN_AT: (u64, u32) = (8, 0);
+/// From this step on, the first input carries a NaN at the next exchange.
+const NAN_FROM: u64 = 8;
+
+/// The exchanges (n, s) of `cfg`, in order.
+fn exchanges(cfg: &NodeConfig) -> impl Iterator<Item = (u64, u32)> + '_ {
+    (0..cfg.steps).flat_map(move |n| {
+        (0..4u32).filter_map(move |s| cfg.coupling.exchanges_at(n, s as usize).then_some((n, s)))
+    })
+}
+
+/// The first exchange at or after step `from` that is followed by another
+/// exchange.
+fn exchange_from(cfg: &NodeConfig, from: u64) -> Option<(u64, u32)> {
+    let mut it = exchanges(cfg).skip_while(|&(n, _)| n < from);
+    let first = it.next()?;
+    it.next().map(|_| first)
+}
 /// Longest wait for the candidate to exit (after Stop, or with a bad config).
 const EXIT_TIMEOUT: Duration = Duration::from_secs(10);
 
@@ -497,6 +513,8 @@ fn drive(
 
     // Lockstep.
     let mut hood = Neighbourhood::new(net, index);
+    let withhold_at = exchange_from(cfg, WITHHOLD_FROM);
+    let nan_at = exchange_from(cfg, NAN_FROM.max(withhold_at.map_or(0, |w| w.0 + 1)));
     let stage_timeout = Duration::from_secs_f64(opts.stage_timeout);
     let mut early: Option<StateMsg> = None;
     let mut after_nan = false;
@@ -507,11 +525,11 @@ fn drive(
                 hood.advance();
                 continue;
             }
-            let withhold = (n, s) == WITHHOLD_AT;
+            let withhold = Some((n, s)) == withhold_at;
             let publish = |hood: &Neighbourhood| {
                 for (k, (&j, p)) in cfg.inputs.iter().zip(input_pubs).enumerate() {
                     let mut m = StateMsg::new(j, n, s, &hood.exchange_of(net, j));
-                    if (n, s) == NAN_AT && k == 0 {
+                    if Some((n, s)) == nan_at && k == 0 {
                         m.w[0] = f64::NAN;
                     }
                     let _ = p.send_copy(m);
@@ -585,7 +603,7 @@ fn drive(
                     if after_nan {
                         report.fail(
                             RuleId::RefusesInvalid,
-                            format!("after a NaN input at step {} stage {}, its state at step {n} stage {s}: {why}", NAN_AT.0, NAN_AT.1),
+                            format!("after a NaN input, its state at step {n} stage {s}: {why}"),
                         );
                     }
                     None
@@ -609,7 +627,7 @@ fn drive(
                 }
                 publish(&hood);
             }
-            if (n, s) == NAN_AT {
+            if Some((n, s)) == nan_at {
                 after_nan = true;
             }
             last_cand = cand.or(last_cand);
@@ -625,7 +643,7 @@ fn drive(
     } else {
         report.not_checked(RuleId::RefusesInvalid, "the run is too short to inject a NaN");
     }
-    if cfg.steps <= WITHHOLD_AT.0 {
+    if withhold_at.is_none() {
         report.not_checked(RuleId::WaitsForInputs, "the run is too short to hold inputs back");
     }
 

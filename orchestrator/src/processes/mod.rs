@@ -266,6 +266,7 @@ pub fn run(
         links: Vec::new(),
         pacing: vec![(0, 0.0); n_nodes],
         blamed: Vec::new(),
+        gave_up: Vec::new(),
     };
     let failure = (|| -> Option<String> {
         // Phase 1: every node ready.
@@ -429,22 +430,36 @@ struct Collector {
     pacing: Vec<(u64, f64)>,
     /// (node index, id of the input it timed out waiting for).
     blamed: Vec<(usize, u32)>,
+    /// Nodes that reported giving up.
+    gave_up: Vec<usize>,
 }
 
 impl Collector {
     /// Names the nodes others gave up waiting for, if any did.
     fn blame(&self, net: &Network, plugins: &[Plugin]) -> Option<String> {
-        let mut silent: Vec<u32> = self.blamed.iter().map(|&(_, id)| id).collect();
-        silent.sort_unstable();
-        silent.dedup();
+        let index_of = |id: u32| {
+            if id == 0 {
+                0
+            } else {
+                1 + net.agents.iter().position(|a| a.model.id == id).unwrap_or(0)
+            }
+        };
+        let mut blamed: Vec<u32> = self.blamed.iter().map(|&(_, id)| id).collect();
+        blamed.sort_unstable();
+        blamed.dedup();
+        // Lockstep propagates a hang: the nodes waiting for the silent one
+        // stop publishing too. The cause is a blamed node that did not give
+        // up waiting itself (if every blamed node did, list them all).
+        let roots: Vec<u32> = blamed
+            .iter()
+            .copied()
+            .filter(|&id| !self.gave_up.contains(&index_of(id)))
+            .collect();
+        let silent = if roots.is_empty() { blamed } else { roots };
         let lines: Vec<String> = silent
             .iter()
             .map(|&id| {
-                let index = if id == 0 {
-                    0
-                } else {
-                    1 + net.agents.iter().position(|a| a.model.id == id).unwrap_or(0)
-                };
+                let index = index_of(id);
                 let waiters: Vec<String> = self
                     .blamed
                     .iter()
@@ -496,7 +511,12 @@ impl Collector {
                         self.peaks[i] = m.peak_torque;
                         self.pacing[i] = (m.w[0] as u64, m.w[1]);
                     }
-                    Some(TelemetryKind::Failed) => self.blamed.push((i, m.step as u32)),
+                    Some(TelemetryKind::Failed) => {
+                        self.gave_up.push(i);
+                        if let Ok(id) = u32::try_from(m.step) {
+                            self.blamed.push((i, id));
+                        }
+                    }
                     None => {
                         return Err(format!(
                             "node {} sent telemetry of unknown kind {}",
