@@ -93,7 +93,7 @@ enum Command {
         /// Converged: complete, and every agent's final attitude error below this.
         #[arg(long, default_value_t = 1e-3)]
         tolerance: f64,
-        /// Bisect between the first value (must converge) and the last (must not).
+        /// Bisect between the first value that does not converge and the one before it (the first must converge).
         #[arg(long)]
         find_margin: bool,
         /// Bisection iterations.

@@ -140,7 +140,13 @@ pub fn run(
         }
         Engine::Processes => {
             let out = processes::run(net, &process_opts, &dir.join("logs"), interrupt, record)?;
-            (out.peak_torques, out.steps, out.failure, out.links, out.pacing)
+            (
+                out.peak_torques,
+                out.steps,
+                out.failure,
+                out.links,
+                out.pacing,
+            )
         }
     };
     let wall_seconds = started.elapsed().as_secs_f64();

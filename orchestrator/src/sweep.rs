@@ -147,31 +147,28 @@ pub fn sweep(o: &SweepOptions, interrupt: &AtomicBool) -> Result<SweepResult, St
             v.parse::<f64>()
                 .map_err(|_| format!("--find-margin needs numeric values, got {v:?}"))
         };
-        let (first, last) = (&rows[0], &rows[rows.len() - 1]);
-        let (mut lo, mut hi) = (parse(&first.value)?, parse(&last.value)?);
-        if !first.converged || last.converged {
+        // Bracket: the first value that does not converge and the one before it.
+        let Some(k) = rows.iter().position(|r| !r.converged) else {
             return Err(format!(
-                "--find-margin needs the first value to converge and the last not to: {} = {} {}, {} = {} {}",
-                o.param,
-                first.value,
-                if first.converged {
-                    "converges"
-                } else {
-                    "does not converge"
-                },
-                o.param,
-                last.value,
-                if last.converged {
-                    "converges"
-                } else {
-                    "does not converge"
-                }
+                "--find-margin needs a value that does not converge: every value of {} converges",
+                o.param
+            ));
+        };
+        if k == 0 {
+            return Err(format!(
+                "--find-margin needs the first value to converge: {} = {} does not",
+                o.param, rows[0].value
             ));
         }
+        let (mut lo, mut hi) = (parse(&rows[k - 1].value)?, parse(&rows[k].value)?);
         for _ in 0..iterations {
             let mut mid = 0.5 * (lo + hi);
             if quantum > 0.0 {
-                mid = (mid / quantum).round() * quantum;
+                // A multiple of the quantum, written without round-off noise.
+                let decimals = (-quantum.log10()).ceil().max(0.0) as usize + 1;
+                mid = format!("{:.decimals$}", (mid / quantum).round() * quantum)
+                    .parse()
+                    .expect("a formatted number parses");
                 if mid <= lo.min(hi) + quantum * 0.5 || mid >= lo.max(hi) - quantum * 0.5 {
                     break;
                 }

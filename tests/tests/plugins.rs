@@ -24,7 +24,11 @@ fn toml_str(p: &Path) -> String {
 fn a_plugin_running_the_builtin_agent_changes_nothing() {
     let tmp = Sandbox::new("plugin-identity");
     let agent = bin("attsync-agent");
-    let scenario = with_agent_3(&tmp, "identity", &format!("command = [{}]", toml_str(&agent)));
+    let scenario = with_agent_3(
+        &tmp,
+        "identity",
+        &format!("command = [{}]", toml_str(&agent)),
+    );
     let (p, b) = (tmp.join("plugin"), tmp.join("builtin"));
     let sets = ["simulation.duration=1"];
     Attsync::new(tmp.path())
@@ -33,7 +37,12 @@ fn a_plugin_running_the_builtin_agent_changes_nothing() {
         .assert_ok()
         .assert_no_leftovers();
     Attsync::new(tmp.path())
-        .args(run_args(&paper("constant-observerless"), "processes", &b, &sets))
+        .args(run_args(
+            &paper("constant-observerless"),
+            "processes",
+            &b,
+            &sets,
+        ))
         .output()
         .assert_ok();
     assert_same_bytes(&p.join("errors.csv"), &b.join("errors.csv"));
@@ -64,7 +73,12 @@ fn a_plugin_gets_its_env_its_config_and_the_scenario_directory() {
     std::fs::create_dir(tmp.join("elsewhere")).unwrap();
     let out = tmp.join("out");
     Attsync::new(&tmp.join("elsewhere"))
-        .args(run_args(&scenario, "processes", &out, &["simulation.duration=0.2"]))
+        .args(run_args(
+            &scenario,
+            "processes",
+            &out,
+            &["simulation.duration=0.2"],
+        ))
         .output()
         .assert_ok();
     assert_eq!(summary(&out)["complete"], true);
@@ -79,7 +93,10 @@ fn a_plugin_that_hangs_is_named_and_nothing_is_left_running() {
     let scenario = with_agent_3(
         &tmp,
         "hang",
-        &format!("command = [\"sh\", \"-c\", {script:?}, {}]", toml_str(&agent)),
+        &format!(
+            "command = [\"sh\", \"-c\", {script:?}, {}]",
+            toml_str(&agent)
+        ),
     );
     let out = tmp.join("out");
     let mut args = run_args(&scenario, "processes", &out, &["simulation.duration=40"]);
@@ -97,7 +114,13 @@ fn a_plugin_that_hangs_is_named_and_nothing_is_left_running() {
     }
     let s = summary(&out);
     assert_eq!(s["complete"], false);
-    assert!(s["incomplete_reason"].as_str().unwrap().contains("agent-3 (plug-in"), "{s:#}");
+    assert!(
+        s["incomplete_reason"]
+            .as_str()
+            .unwrap()
+            .contains("agent-3 (plug-in"),
+        "{s:#}"
+    );
 }
 
 #[test]
@@ -113,15 +136,27 @@ fn a_missing_plugin_program_is_a_scenario_error() {
         .output();
     r.assert_code(2);
     assert!(r.stderr.contains("agent[2].command[0]"), "{}", r.describe());
-    assert!(r.stderr.contains("./no-such-agent: no such file"), "{}", r.describe());
+    assert!(
+        r.stderr.contains("./no-such-agent: no such file"),
+        "{}",
+        r.describe()
+    );
     assert!(r.stderr.contains("agent[2].env"), "{}", r.describe());
     assert!(!tmp.join("out").exists());
 
     // And the in-process engine cannot run a plug-in.
-    let ok = with_agent_3(&tmp, "ok", &format!("command = [{}]", toml_str(&bin("attsync-agent"))));
+    let ok = with_agent_3(
+        &tmp,
+        "ok",
+        &format!("command = [{}]", toml_str(&bin("attsync-agent"))),
+    );
     let r = Attsync::new(tmp.path())
         .args(run_args(&ok, "in-process", &tmp.join("out"), &[]))
         .output();
     r.assert_code(2);
-    assert!(r.stderr.contains("plug-ins need --engine processes"), "{}", r.describe());
+    assert!(
+        r.stderr.contains("plug-ins need --engine processes"),
+        "{}",
+        r.describe()
+    );
 }

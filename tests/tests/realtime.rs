@@ -32,7 +32,10 @@ fn realtime_runs_and_measures_a_nonzero_age_of_information() {
         let delivered = l["delivered"].as_u64().unwrap();
         assert!(delivered >= exchanges / 2, "{l}");
         assert_eq!(l["lost"].as_u64().unwrap(), exchanges - delivered, "{l}");
-        let (mean, max) = (l["aoi_mean"].as_f64().unwrap(), l["aoi_max"].as_f64().unwrap());
+        let (mean, max) = (
+            l["aoi_mean"].as_f64().unwrap(),
+            l["aoi_max"].as_f64().unwrap(),
+        );
         assert!(mean > 0.0 && mean <= max, "{l}");
         // Shared memory on one machine: far below a second.
         assert!(max < 0.5, "{l}");
@@ -55,8 +58,16 @@ fn realtime_runs_and_measures_a_nonzero_age_of_information() {
         .output()
         .assert_ok();
     let l = summary(&lock);
-    for (a, b) in s["agents"].as_array().unwrap().iter().zip(l["agents"].as_array().unwrap()) {
-        let (x, y) = (a["final_att_err"].as_f64().unwrap(), b["final_att_err"].as_f64().unwrap());
+    for (a, b) in s["agents"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(l["agents"].as_array().unwrap())
+    {
+        let (x, y) = (
+            a["final_att_err"].as_f64().unwrap(),
+            b["final_att_err"].as_f64().unwrap(),
+        );
         assert!((x - y).abs() <= 0.25 * y, "real-time {x} vs lockstep {y}");
     }
 }
@@ -92,7 +103,12 @@ fn realtime_refuses_what_it_cannot_honour() {
     with_delay.push("--realtime".into());
     let r = Attsync::new(tmp.path()).args(with_delay).output();
     r.assert_code(2);
-    assert!(r.stderr.contains("--realtime cannot be combined with [network]"), "{}", r.describe());
+    assert!(
+        r.stderr
+            .contains("--realtime cannot be combined with [network]"),
+        "{}",
+        r.describe()
+    );
 
     let mut in_process = run_args(&scenario, "in-process", &tmp.join("b"), &[]);
     in_process.extend(["--realtime".into(), "2".into()]);

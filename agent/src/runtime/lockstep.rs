@@ -33,7 +33,10 @@ pub(crate) fn run<S: Service, N: Stepper>(
         }
         for s in 0..4u32 {
             if cfg.coupling.exchanges_at(n, s as usize) {
-                ports.publish(StateMsg::new(cfg.id, n, s, &stepper.stage_exchange()), notify)?;
+                ports.publish(
+                    StateMsg::new(cfg.id, n, s, &stepper.stage_exchange()),
+                    notify,
+                )?;
                 let deadline = Instant::now() + stage_timeout;
                 waiter.begin();
                 for k in 0..ports.inputs.len() {

@@ -66,7 +66,9 @@ pub enum NodeError {
         waited: f64,
     },
     /// An input's state did not arrive in time.
-    #[error("timed out after {waited:.1} s waiting for node {from}'s state of step {step} stage {stage}")]
+    #[error(
+        "timed out after {waited:.1} s waiting for node {from}'s state of step {step} stage {stage}"
+    )]
     InputTimeout {
         /// The silent node.
         from: u32,
@@ -173,7 +175,12 @@ impl Inputs {
     }
 
     /// Checks message `msg` of input `k`: `Some(value)` if it can be used.
-    pub(crate) fn accept(&mut self, cfg: &NodeConfig, k: usize, msg: &StateMsg) -> Option<Exchanged> {
+    pub(crate) fn accept(
+        &mut self,
+        cfg: &NodeConfig,
+        k: usize,
+        msg: &StateMsg,
+    ) -> Option<Exchanged> {
         match msg.validated() {
             Ok(x) => Some(x),
             Err(why) => {

@@ -150,9 +150,7 @@ impl<S: Service> Ports<S> {
 
     /// Sends a telemetry message and wakes the orchestrator.
     pub fn report(&self, m: TelemetryMsg) -> Result<(), NodeError> {
-        self.tele_pub
-            .send_copy(m)
-            .map_err(port("telemetry send"))?;
+        self.tele_pub.send_copy(m).map_err(port("telemetry send"))?;
         let _ = self.orch_notifier.notify();
         Ok(())
     }

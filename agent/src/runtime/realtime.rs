@@ -135,9 +135,7 @@ pub(crate) fn run<S: Service, N: Stepper>(
                             waited: cfg.stage_timeout,
                         });
                     }
-                    let _ = ports
-                        .listener
-                        .timed_wait(|_| {}, Duration::from_millis(1));
+                    let _ = ports.listener.timed_wait(|_| {}, Duration::from_millis(1));
                 }
                 if let Some((x, sent)) = fresh {
                     stepper.receive(k, x);
@@ -169,6 +167,11 @@ pub(crate) fn run<S: Service, N: Stepper>(
     tracing::info!(late_stages, max_late_s = max_late, "real-time pacing");
     Ok(TelemetryMsg {
         w: [late_stages as f64, max_late, 0.0],
-        ..TelemetryMsg::bare(cfg.id, cfg.steps, TelemetryKind::Done, stepper.peak_torque())
+        ..TelemetryMsg::bare(
+            cfg.id,
+            cfg.steps,
+            TelemetryKind::Done,
+            stepper.peak_torque(),
+        )
     })
 }

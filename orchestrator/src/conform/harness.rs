@@ -158,7 +158,12 @@ pub(super) fn version_probe(
     Ok(())
 }
 
-fn candidate_config(net: &Network, index: usize, ns: &Namespace, opts: &ConformOptions) -> NodeConfig {
+fn candidate_config(
+    net: &Network,
+    index: usize,
+    ns: &Namespace,
+    opts: &ConformOptions,
+) -> NodeConfig {
     let popts = ProcessOptions {
         stage_timeout: opts.stage_timeout,
         start_timeout: opts.start_timeout,
@@ -210,7 +215,10 @@ impl Neighbourhood {
             return self.leader.stage_exchange();
         }
         let i = net.index_of(id).expect("an input of the candidate");
-        self.agents[i].as_ref().expect("not the candidate").stage_exchange()
+        self.agents[i]
+            .as_ref()
+            .expect("not the candidate")
+            .stage_exchange()
     }
 
     /// One exchange: every node but the candidate receives, with `cand` the candidate's value.
@@ -224,7 +232,11 @@ impl Neighbourhood {
         for (i, agent) in self.agents.iter_mut().enumerate() {
             let Some(agent) = agent else { continue };
             for (k, &j) in self.nbr_index[i].iter().enumerate() {
-                let x = if j == self.candidate { cand } else { published[j] };
+                let x = if j == self.candidate {
+                    cand
+                } else {
+                    published[j]
+                };
                 if let Some(x) = x {
                     agent.receive_neighbour(k, x);
                 }
@@ -274,18 +286,29 @@ impl TelemetryCheck {
                 }
             };
             if m.version != PROTOCOL_VERSION {
-                bad(format!("telemetry of version {}, expected {PROTOCOL_VERSION}", m.version));
+                bad(format!(
+                    "telemetry of version {}, expected {PROTOCOL_VERSION}",
+                    m.version
+                ));
             }
             if m.sender != id {
-                bad(format!("telemetry claims sender {}, expected {id}", m.sender));
+                bad(format!(
+                    "telemetry claims sender {}, expected {id}",
+                    m.sender
+                ));
             }
             match TelemetryKind::from_u32(m.kind) {
                 Some(TelemetryKind::Ready) => self.ready = true,
                 Some(TelemetryKind::Sample) => {
                     let x = m.agent_state();
                     let finite = m.r.iter().chain(&m.w).all(|v| v.is_finite());
-                    if !finite || attitude::so3::orthogonality_defect(&x.r) > msgs::ROTATION_TOLERANCE {
-                        bad(format!("sample at step {} is not finite or R is not a rotation", m.step));
+                    if !finite
+                        || attitude::so3::orthogonality_defect(&x.r) > msgs::ROTATION_TOLERANCE
+                    {
+                        bad(format!(
+                            "sample at step {} is not finite or R is not a rotation",
+                            m.step
+                        ));
                     }
                     if self.done {
                         bad(format!("sample at step {} after Done", m.step));
@@ -404,7 +427,17 @@ pub(super) fn session(
     let mut tcheck = TelemetryCheck::new(&cfg);
 
     let outcome = drive(
-        net, index, &cfg, opts, report, &mut child, &control, &tele, &input_pubs, &subs, &cand_wake,
+        net,
+        index,
+        &cfg,
+        opts,
+        report,
+        &mut child,
+        &control,
+        &tele,
+        &input_pubs,
+        &subs,
+        &cand_wake,
         &mut tcheck,
     );
     if outcome.is_err() {
@@ -418,7 +451,9 @@ pub(super) fn session(
     if !leftovers.is_empty() {
         report.fail(
             RuleId::Clean,
-            format!("processes {leftovers:?} of its process group were still running after it exited"),
+            format!(
+                "processes {leftovers:?} of its process group were still running after it exited"
+            ),
         );
         kill_group(pgid);
     }
@@ -427,9 +462,9 @@ pub(super) fn session(
         match &state {
             NodeState::Alive(v) if v.id() == node.id() => {}
             NodeState::Alive(_) => others.push("an iceoryx2 node still alive".to_string()),
-            NodeState::Dead(_) => others.push(
-                "an iceoryx2 node whose process died without releasing it".to_string(),
-            ),
+            NodeState::Dead(_) => {
+                others.push("an iceoryx2 node whose process died without releasing it".to_string())
+            }
             NodeState::Inaccessible(_) | NodeState::Undefined(_) => {
                 others.push("an inaccessible or broken iceoryx2 node".to_string());
             }
@@ -490,7 +525,10 @@ fn drive(
             };
             report.fail(
                 RuleId::Connects,
-                format!("it ended ({}) before reporting Ready{hint}; its last output:\n{tail}", describe(&st)),
+                format!(
+                    "it ended ({}) before reporting Ready{hint}; its last output:\n{tail}",
+                    describe(&st)
+                ),
             );
             skip_rest(report, "it never connected");
             return Ok(());
@@ -506,7 +544,10 @@ fn drive(
         std::thread::sleep(Duration::from_millis(2));
     }
     report.pass(RuleId::Connects);
-    if control.send_copy(ControlMsg::new(ControlCommand::Start)).is_err() {
+    if control
+        .send_copy(ControlMsg::new(ControlCommand::Start))
+        .is_err()
+    {
         report.fail(RuleId::Connects, "attsync could not send Start");
         return Err(());
     }
@@ -565,7 +606,10 @@ fn drive(
                 if Instant::now() > deadline {
                     report.fail(
                         RuleId::InOrder,
-                        format!("no state for step {n} stage {s} within {} s", opts.stage_timeout),
+                        format!(
+                            "no state for step {n} stage {s} within {} s",
+                            opts.stage_timeout
+                        ),
                     );
                     skip_rest(report, "it stopped publishing");
                     return Err(());
@@ -641,10 +685,16 @@ fn drive(
     if after_nan {
         report.pass(RuleId::RefusesInvalid);
     } else {
-        report.not_checked(RuleId::RefusesInvalid, "the run is too short to inject a NaN");
+        report.not_checked(
+            RuleId::RefusesInvalid,
+            "the run is too short to inject a NaN",
+        );
     }
     if withhold_at.is_none() {
-        report.not_checked(RuleId::WaitsForInputs, "the run is too short to hold inputs back");
+        report.not_checked(
+            RuleId::WaitsForInputs,
+            "the run is too short to hold inputs back",
+        );
     }
 
     // Done, then Stop.
@@ -657,13 +707,19 @@ fn drive(
         Ok(()) => report.pass(RuleId::Telemetry),
         Err(why) => report.fail(RuleId::Telemetry, why),
     }
-    if control.send_copy(ControlMsg::new(ControlCommand::Stop)).is_err() {
+    if control
+        .send_copy(ControlMsg::new(ControlCommand::Stop))
+        .is_err()
+    {
         report.not_checked(RuleId::Stops, "attsync could not send Stop");
         return Err(());
     }
     match wait_exit(child, EXIT_TIMEOUT) {
         Some(st) if st.success() => report.pass(RuleId::Stops),
-        Some(st) => report.fail(RuleId::Stops, format!("told to stop, it ended with {}", describe(&st))),
+        Some(st) => report.fail(
+            RuleId::Stops,
+            format!("told to stop, it ended with {}", describe(&st)),
+        ),
         None => {
             report.fail(
                 RuleId::Stops,

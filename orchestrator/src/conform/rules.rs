@@ -152,7 +152,12 @@ impl Report {
     /// The verdict of `id`.
     #[must_use]
     pub fn verdict(&self, id: RuleId) -> &Verdict {
-        &self.rules.iter().find(|r| r.id == id).expect("present").verdict
+        &self
+            .rules
+            .iter()
+            .find(|r| r.id == id)
+            .expect("present")
+            .verdict
     }
 
     /// Whether every rule passed.
@@ -173,7 +178,11 @@ impl Report {
             };
             let _ = writeln!(s, "{tag}  {:<17} {}{why}", r.id.name(), r.id.text());
         }
-        let n_pass = self.rules.iter().filter(|r| r.verdict == Verdict::Pass).count();
+        let n_pass = self
+            .rules
+            .iter()
+            .filter(|r| r.verdict == Verdict::Pass)
+            .count();
         let _ = write!(
             s,
             "{n_pass}/{} rules pass; the candidate's output: {}",

@@ -7,6 +7,7 @@
 pub mod namespace;
 pub mod supervise;
 
+use crate::scenario::plugin::Plugin;
 use attitude::engine::Snapshot;
 use attitude::link::LinkStats;
 use attitude::network::{AgentState, Network};
@@ -15,7 +16,6 @@ use iceoryx2::node::NodeBuilder;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use msgs::config::{NodeConfig, Role, WaitStrategy};
-use crate::scenario::plugin::Plugin;
 use msgs::{ControlCommand, ControlMsg, Limits, PROTOCOL_VERSION, TelemetryKind, TelemetryMsg};
 use namespace::Namespace;
 use std::collections::VecDeque;
@@ -247,7 +247,14 @@ pub fn run(
             Some(p) => {
                 env.extend(p.env.iter().map(|(k, v)| (k.clone(), v.clone())));
                 let args: Vec<String> = p.command[1..].iter().cloned().chain(config_arg).collect();
-                sup.spawn(i, Path::new(&p.command[0]), &args, &env, Some(&p.dir), &log_of(i))
+                sup.spawn(
+                    i,
+                    Path::new(&p.command[0]),
+                    &args,
+                    &env,
+                    Some(&p.dir),
+                    &log_of(i),
+                )
             }
             None => {
                 let bin = if i == 0 { &leader_bin } else { &agent_bin };
@@ -362,7 +369,13 @@ pub fn run(
             let bad: Vec<String> = exits
                 .iter()
                 .filter(|e| !matches!(&e.status, Ok(s) if s.success()))
-                .map(|e| format!("{}: {}", node_label(net, &opts.plugins, e.index), describe(&e.status)))
+                .map(|e| {
+                    format!(
+                        "{}: {}",
+                        node_label(net, &opts.plugins, e.index),
+                        describe(&e.status)
+                    )
+                })
                 .collect();
             if !bad.is_empty() {
                 return Ok(Outcome {
@@ -441,7 +454,11 @@ impl Collector {
             if id == 0 {
                 0
             } else {
-                1 + net.agents.iter().position(|a| a.model.id == id).unwrap_or(0)
+                1 + net
+                    .agents
+                    .iter()
+                    .position(|a| a.model.id == id)
+                    .unwrap_or(0)
             }
         };
         let mut blamed: Vec<u32> = self.blamed.iter().map(|&(_, id)| id).collect();

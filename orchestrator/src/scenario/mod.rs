@@ -122,7 +122,10 @@ pub fn load_str(file: &Path, text: &str, overrides: &[String]) -> Result<Loaded,
         _ => PathBuf::from("."),
     };
     let dir = std::path::absolute(&dir).unwrap_or(dir);
-    let resolved = match (resolve::resolve(&scenario), plugin::resolve(&scenario, &dir)) {
+    let resolved = match (
+        resolve::resolve(&scenario),
+        plugin::resolve(&scenario, &dir),
+    ) {
         (Ok(r), Ok(plugins)) => Ok(resolve::Resolved { plugins, ..r }),
         (Err(mut a), Err(b)) => {
             a.extend(b);
