@@ -4,8 +4,8 @@
 //! 1. open every port; wait (bounded) until every receiver of our state, the
 //!    orchestrator's telemetry subscriber and the sender of every input are
 //!    connected; report `Ready`; wait (bounded) for `Start`;
-//! 2. step, either in deterministic [`lockstep`] (the default) or free
-//!    against the wall clock ([`realtime`]);
+//! 2. step, either in deterministic lockstep (`lockstep.rs`, the default) or free
+//!    against the wall clock (`realtime.rs`);
 //! 3. report the counters of the incoming links, then `Done`, and wait
 //!    (bounded) for `Stop`.
 //!
