@@ -342,6 +342,13 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             quantum,
         } => {
             let loaded = scenario::load(&scenario, &set)?;
+            // Every value must make a valid scenario before anything runs
+            // (exit code 2, like an invalid --set).
+            for v in &values {
+                let mut with = set.clone();
+                with.push(format!("{param}={v}"));
+                scenario::load(&scenario, &with)?;
+            }
             let out = out.unwrap_or_else(|| {
                 PathBuf::from("results").join(format!(
                     "{}-sweep-{}",

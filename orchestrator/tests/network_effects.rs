@@ -646,3 +646,33 @@ fn sweep_failures_name_the_field_and_leave_nothing() {
     );
     assert!(entries(cwd).is_empty(), "{:?}", entries(cwd));
 }
+
+/// README, "Exit codes": 2 for an invalid scenario or `--set`. A swept
+/// `--param` value is applied exactly like a `--set` (and reported with the
+/// same `FILE: FIELD: REASON`), so an invalid one must exit 2 as an invalid
+/// `--set` of the same sweep does.
+#[test]
+fn sweep_invalid_param_exits_2_like_an_invalid_set() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cwd = tmp.path();
+    let by_set = sweep(
+        cwd,
+        "network.delay",
+        "0",
+        "sw",
+        &["--set", "network.delai=0"],
+    );
+    assert_eq!(by_set.code, Some(2), "{}", by_set.stderr);
+    assert!(by_set.stderr.contains("network.delai"), "{}", by_set.stderr);
+    for (param, values) in [("network.delai", "0"), ("network.delay", "0,0.0005")] {
+        let out = sweep(cwd, param, values, "sw", &[]);
+        assert!(out.stderr.contains(param), "{}", out.stderr);
+        assert_eq!(
+            out.code,
+            Some(2),
+            "--param {param} --values {values}: {}",
+            out.stderr
+        );
+    }
+    assert!(entries(cwd).is_empty(), "{:?}", entries(cwd));
+}

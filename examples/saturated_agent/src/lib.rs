@@ -64,9 +64,12 @@ pub fn run<S: Service>(
     info!(id = cfg.id, tau_max, "saturated districontrol agent");
     let result = attsync_agent::runtime::run(node, cfg, &mut agent, shutdown);
     let (steps, saturated) = agent.saturated_steps();
+    let span = agent.saturated_span();
     info!(
         steps,
         saturated_steps = saturated,
+        first_saturated_step = span.map(|s| s.0),
+        last_saturated_step = span.map(|s| s.1),
         peak_demanded = agent.peak_demanded(),
         peak_applied = attsync_agent::Stepper::peak_torque(&agent),
         "torque limit"

@@ -41,6 +41,8 @@ pub struct SaturatedAgent {
     peak_demanded: f64,
     steps: u64,
     saturated_steps: u64,
+    /// First and last step that began saturated.
+    saturated_span: Option<(u64, u64)>,
 }
 
 impl SaturatedAgent {
@@ -99,6 +101,7 @@ impl SaturatedAgent {
             peak_demanded: 0.0,
             steps: 0,
             saturated_steps: 0,
+            saturated_span: None,
         })
     }
 
@@ -112,6 +115,12 @@ impl SaturatedAgent {
     #[must_use]
     pub fn saturated_steps(&self) -> (u64, u64) {
         (self.steps, self.saturated_steps)
+    }
+
+    /// The first and the last step that began saturated, if any did.
+    #[must_use]
+    pub fn saturated_span(&self) -> Option<(u64, u64)> {
+        self.saturated_span
     }
 
     /// The full agent state at the start of the current step.
@@ -166,6 +175,8 @@ impl Stepper for SaturatedAgent {
             self.peak_demanded = self.peak_demanded.max(demanded.norm());
             if tau != demanded {
                 self.saturated_steps += 1;
+                let n = self.steps;
+                self.saturated_span = Some(self.saturated_span.map_or((n, n), |(a, _)| (a, n)));
             }
         }
         if let Some(next) = self
