@@ -197,3 +197,140 @@ impl Stepper for SaturatedAgent {
         self.peak_torque
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use attitude::agent::Agent;
+    use attitude::body::Inertia;
+    use attitude::network::{Coupling, Neighbour};
+    use attitude::so3::rot;
+    use msgs::Limits;
+    use msgs::config::WaitStrategy;
+
+    /// Agent 3 of the paper's scheme-3 experiment, hearing neighbour 1 and
+    /// the leader (a made-up neighbourhood: the inputs are held constant).
+    fn config() -> NodeConfig {
+        let u2 = Vector3::new(1.0, 1.0, 0.0).normalize();
+        let model = AgentModel {
+            id: 3,
+            inertia: Inertia::new(Matrix3::from_diagonal(&Vector3::new(0.3, 0.5, 0.6))),
+            a_bar: Matrix3::identity(),
+            neighbours: vec![Neighbour {
+                id: 1,
+                a: Matrix3::from_diagonal(&Vector3::new(9.0, 8.0, 7.0)),
+                link: None,
+            }],
+            leader_gain: Some(Matrix3::from_diagonal(&Vector3::new(8.0, 9.0, 10.0))),
+            leader_link: None,
+            scheme: Scheme::Observerless {
+                control: ControlGains { k_r: 1.9, k_w: 1.9 },
+            },
+            p: Matrix3::zeros(),
+        };
+        let initial = AgentState {
+            r: rot(0.3 * std::f64::consts::PI, &u2),
+            w: Vector3::new(3.5, 3.0, 4.0),
+            r_hat: Matrix3::identity(),
+            w_hat: Vector3::zeros(),
+            s_hat: Vector3::zeros(),
+        };
+        NodeConfig {
+            protocol_version: msgs::PROTOCOL_VERSION,
+            run: "test".into(),
+            iox_root: "/tmp/".into(),
+            id: 3,
+            dt: 0.001,
+            steps: 3000,
+            coupling: Coupling::Continuous,
+            sample_every: 10,
+            inputs: vec![1, 0],
+            outputs: vec![1],
+            limits: Limits {
+                nodes: 3,
+                max_fanout: 1,
+                state_buffer: 64,
+                telemetry_buffer: 256,
+            },
+            wait: WaitStrategy::Adaptive,
+            stage_timeout: 10.0,
+            start_timeout: 30.0,
+            realtime: None,
+            role: Role::Agent {
+                model: Box::new(model),
+                initial,
+            },
+        }
+    }
+
+    fn inputs() -> [Exchanged; 2] {
+        let u = Vector3::new(1.0, 4.0, 2.0).normalize();
+        let nbr = Exchanged {
+            r: rot(0.1 * std::f64::consts::PI, &u),
+            ..Exchanged::identity()
+        };
+        let leader = Exchanged {
+            r: rot(0.8 * std::f64::consts::PI, &u),
+            ..Exchanged::identity()
+        };
+        [nbr, leader]
+    }
+
+    /// Runs `steps` steps with constant inputs; returns the final state.
+    fn drive(a: &mut SaturatedAgent, steps: u64) -> AgentState {
+        for _ in 0..steps * 4 {
+            for (k, x) in inputs().into_iter().enumerate() {
+                a.receive(k, x);
+            }
+            a.advance();
+        }
+        a.state()
+    }
+
+    #[test]
+    fn without_a_limit_it_is_the_builtin_agent_bit_for_bit() {
+        let cfg = config();
+        let Role::Agent { model, initial } = &cfg.role else {
+            unreachable!()
+        };
+        let mut builtin = Agent::new((**model).clone(), *initial, cfg.dt);
+        let [nbr, leader] = inputs();
+        for _ in 0..cfg.steps * 4 {
+            builtin.receive_neighbour(0, nbr);
+            builtin.receive_leader(leader);
+            builtin.advance();
+        }
+        let mut ours = SaturatedAgent::from_config(&cfg, f64::INFINITY).expect("valid");
+        let x = drive(&mut ours, cfg.steps);
+        assert_eq!(x, *builtin.state());
+        assert_eq!(ours.peak_torque, builtin.peak_torque());
+        assert_eq!(ours.saturated_steps(), (cfg.steps, 0));
+    }
+
+    #[test]
+    fn the_applied_torque_never_exceeds_the_limit() {
+        let cfg = config();
+        let mut a = SaturatedAgent::from_config(&cfg, 2.0).expect("valid");
+        drive(&mut a, cfg.steps);
+        assert!(
+            a.peak_demanded() > 2.0,
+            "the limit must bite: {}",
+            a.peak_demanded()
+        );
+        assert!(
+            a.peak_torque <= 2.0 && a.peak_torque > 2.0 - 1e-12,
+            "{}",
+            a.peak_torque
+        );
+        assert_eq!(a.saturated_span().map(|s| s.0), Some(0));
+    }
+
+    #[test]
+    fn what_it_does_not_implement_is_refused() {
+        let mut cfg = config();
+        cfg.inputs = vec![0, 1];
+        assert!(SaturatedAgent::from_config(&cfg, 2.0).is_err());
+        assert!(SaturatedAgent::from_config(&config(), 0.0).is_err());
+        assert!(SaturatedAgent::from_config(&config(), f64::NAN).is_err());
+    }
+}
