@@ -217,6 +217,14 @@ impl Attsync {
         self
     }
 
+    /// Sets an environment variable.
+    #[must_use]
+    pub fn env(mut self, key: &str, value: &str) -> Self {
+        self.what = format!("{key}={value} {}", self.what);
+        self.cmd.env(key, value);
+        self
+    }
+
     /// Starts it.
     #[must_use]
     pub fn spawn(mut self) -> Running {

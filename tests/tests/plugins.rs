@@ -160,3 +160,31 @@ fn a_missing_plugin_program_is_a_scenario_error() {
         r.describe()
     );
 }
+
+#[test]
+fn the_saturated_rust_example_converges_within_its_torque_limit() {
+    let tmp = Sandbox::new("plugin-saturated");
+    let out = tmp.join("out");
+    let scenario = attsync_tests::scenario("plugin/saturated-observerless.toml");
+    let text = read(&scenario);
+    assert!(
+        text.contains("SATURATED_TAU_MAX = \"3.0\""),
+        "the scenario's limit changed"
+    );
+    // The scenario names ../../target/release/saturated-agent; point it at
+    // this build's binary, wherever the target directory is.
+    let command = format!("agent[2].command=[{}]", toml_str(&bin("saturated-agent")));
+    Attsync::new(tmp.path())
+        .args(run_args(&scenario, "processes", &out, &[&command]))
+        .output()
+        .assert_ok()
+        .assert_no_leftovers();
+    let s = summary(&out);
+    assert_eq!(s["complete"], true);
+    assert!(s["max_final_att_err"].as_f64().unwrap() < 1e-3, "{s:#}");
+    let a3 = &s["agents"][2];
+    assert_eq!(a3["id"], 3);
+    let peak = a3["peak_torque"].as_f64().unwrap();
+    // Built-in agent 3 peaks at ≈ 8.47 N·m: the limit binds.
+    assert!(peak <= 3.0 && peak > 2.9, "peak torque {peak}");
+}

@@ -62,10 +62,13 @@ pub(crate) fn run<S: Service, N: Stepper>(
                     };
                     check_origin(&msg, cfg.inputs[k])?;
                     if (msg.step, msg.stage) != (n, s) {
-                        return Err(NodeError::Protocol(format!(
-                            "node {} sent step {} stage {} where step {n} stage {s} was due",
-                            cfg.inputs[k], msg.step, msg.stage
-                        )));
+                        return Err(NodeError::BadInput {
+                            from: cfg.inputs[k],
+                            why: format!(
+                                "it sent step {} stage {} where step {n} stage {s} was due",
+                                msg.step, msg.stage
+                            ),
+                        });
                     }
                     // A refused value is like a lost message: keep what we had.
                     if let Some(x) = inputs.accept(cfg, k, &msg) {

@@ -79,6 +79,14 @@ pub enum NodeError {
         /// How long, s.
         waited: f64,
     },
+    /// An input broke the protocol.
+    #[error("protocol violation by node {from}: {why}")]
+    BadInput {
+        /// The offending node.
+        from: u32,
+        /// What it did.
+        why: String,
+    },
     /// A peer broke the protocol.
     #[error("protocol violation: {0}")]
     Protocol(String),
@@ -132,11 +140,15 @@ pub fn run<S: Service, N: Stepper>(
             // Tell the orchestrator whom we waited for (or that it was
             // something else), so that it can name the node that hangs
             // (best effort: we are failing anyway).
-            let whom = match e {
-                NodeError::InputTimeout { from, .. } => u64::from(from),
-                _ => u64::MAX,
+            let (whom, why) = match e {
+                NodeError::InputTimeout { from, .. } => (u64::from(from), FAILED_TIMEOUT),
+                NodeError::BadInput { from, .. } => (u64::from(from), FAILED_BAD_INPUT),
+                _ => (u64::MAX, 0.0),
             };
-            let _ = ports.report(TelemetryMsg::bare(cfg.id, whom, TelemetryKind::Failed, 0.0));
+            let _ = ports.report(TelemetryMsg {
+                w: [why, 0.0, 0.0],
+                ..TelemetryMsg::bare(cfg.id, whom, TelemetryKind::Failed, 0.0)
+            });
             return Err(e);
         }
     };
@@ -226,6 +238,11 @@ impl Inputs {
     }
 }
 
+/// `Failed` reason (`w[0]`): an input's state did not arrive in time.
+pub const FAILED_TIMEOUT: f64 = 1.0;
+/// `Failed` reason (`w[0]`): an input broke the protocol.
+pub const FAILED_BAD_INPUT: f64 = 2.0;
+
 /// Longest wait for `Stop` after the last step.
 const STOP_TIMEOUT: Duration = Duration::from_secs(600);
 
@@ -268,16 +285,19 @@ impl Orphan {
 /// The message must be from `sender` and speak our version.
 pub(crate) fn check_origin(m: &StateMsg, sender: u32) -> Result<(), NodeError> {
     if m.version != PROTOCOL_VERSION {
-        return Err(NodeError::Protocol(format!(
-            "node {sender} speaks protocol version {}, this node {PROTOCOL_VERSION}",
-            m.version
-        )));
+        return Err(NodeError::BadInput {
+            from: sender,
+            why: format!(
+                "it speaks protocol version {}, this node {PROTOCOL_VERSION}",
+                m.version
+            ),
+        });
     }
     if m.sender != sender {
-        return Err(NodeError::Protocol(format!(
-            "message on node {sender}'s state service claims sender {}",
-            m.sender
-        )));
+        return Err(NodeError::BadInput {
+            from: sender,
+            why: format!("a message on its state service claims sender {}", m.sender),
+        });
     }
     Ok(())
 }

@@ -274,6 +274,7 @@ pub fn run(
         pacing: vec![(0, 0.0); n_nodes],
         blamed: Vec::new(),
         gave_up: Vec::new(),
+        broke_protocol: Vec::new(),
     };
     let failure = (|| -> Option<String> {
         // Phase 1: every node ready.
@@ -445,6 +446,8 @@ struct Collector {
     blamed: Vec<(usize, u32)>,
     /// Nodes that reported giving up.
     gave_up: Vec<usize>,
+    /// Ids of nodes a receiver caught breaking the protocol.
+    broke_protocol: Vec<u32>,
 }
 
 impl Collector {
@@ -483,11 +486,19 @@ impl Collector {
                     .filter(|&&(_, j)| j == id)
                     .map(|&(i, _)| node_name(net, i))
                     .collect();
-                format!(
-                    "{} stopped answering: {} timed out waiting for its state",
-                    node_label(net, plugins, index),
-                    waiters.join(", ")
-                )
+                if self.broke_protocol.contains(&id) {
+                    format!(
+                        "{} broke the protocol: {} refused its messages (see their logs)",
+                        node_label(net, plugins, index),
+                        waiters.join(", ")
+                    )
+                } else {
+                    format!(
+                        "{} stopped answering: {} timed out waiting for its state",
+                        node_label(net, plugins, index),
+                        waiters.join(", ")
+                    )
+                }
             })
             .collect();
         (!lines.is_empty()).then(|| lines.join("\n"))
@@ -532,6 +543,9 @@ impl Collector {
                         self.gave_up.push(i);
                         if let Ok(id) = u32::try_from(m.step) {
                             self.blamed.push((i, id));
+                            if m.w[0] == 2.0 {
+                                self.broke_protocol.push(id);
+                            }
                         }
                     }
                     None => {
