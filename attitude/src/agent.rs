@@ -130,6 +130,8 @@ pub struct Agent {
     held_leader: Option<Exchanged>,
     /// Impaired links, per input (neighbours, then the leader).
     links: Vec<Option<Link>>,
+    /// Values refused as untrusted, per input (neighbours, then the leader).
+    rejected: Vec<u64>,
     /// Current step index.
     n: u64,
     peak_torque: f64,
@@ -148,9 +150,11 @@ impl Agent {
         if model.leader_gain.is_some() {
             links.push(impaired(&model.leader_link));
         }
+        let rejected = vec![0; links.len()];
         Self {
             model,
             gains,
+            rejected,
             state: initial,
             step: Rkmk4::new(to_lie(&initial), dt),
             dt,
@@ -188,16 +192,27 @@ impl Agent {
 
     /// Stores the value received from the `k`-th neighbour (order of `model.neighbours`).
     /// On an impaired link the message goes through the link's filter (see [`crate::link`]).
+    /// An untrusted value ([`Exchanged::trust`]) is refused and counted; the
+    /// agent keeps what it had, in every engine alike.
     pub fn receive_neighbour(&mut self, k: usize, x: Exchanged) {
+        if x.trust().is_err() {
+            self.rejected[k] += 1;
+            return;
+        }
         match &mut self.links[k] {
             Some(link) => link.offer(self.n, self.step.stage() as u32, x),
             None => self.held_nbrs[k] = x,
         }
     }
 
-    /// Stores the value received from the leader (ignored if not connected).
+    /// Stores the value received from the leader (ignored if not connected;
+    /// refused and counted if untrusted).
     pub fn receive_leader(&mut self, x: Exchanged) {
         let k = self.model.neighbours.len();
+        if self.held_leader.is_some() && x.trust().is_err() {
+            self.rejected[k] += 1;
+            return;
+        }
         let stage = self.step.stage() as u32;
         match (&mut self.held_leader, self.links.get_mut(k)) {
             (Some(_), Some(Some(link))) => link.offer(self.n, stage, x),
@@ -206,7 +221,8 @@ impl Agent {
         }
     }
 
-    /// Counters of every impaired incoming link: (sender id, stats); the leader is 0.
+    /// Counters of every impaired incoming link and of every link on which
+    /// a value was refused: (sender id, stats); the leader is 0.
     #[must_use]
     pub fn link_stats(&self) -> Vec<(u32, LinkStats)> {
         let ids = self
@@ -215,8 +231,12 @@ impl Agent {
             .iter()
             .map(|n| n.id)
             .chain(std::iter::once(0));
-        ids.zip(&self.links)
-            .filter_map(|(id, l)| l.as_ref().map(|l| (id, l.stats())))
+        ids.zip(self.links.iter().zip(&self.rejected))
+            .filter(|(_, (l, r))| l.is_some() || **r > 0)
+            .map(|(id, (l, &rejected))| {
+                let base = l.as_ref().map(Link::stats).unwrap_or_default();
+                (id, LinkStats { rejected, ..base })
+            })
             .collect()
     }
 

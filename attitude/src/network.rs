@@ -38,6 +38,48 @@ impl Exchanged {
             s: Vector3::zeros(),
         }
     }
+
+    /// Whether a receiver may use this value: every number finite and `r`
+    /// a rotation (`‖rᵀr − I‖_F ≤` [`ROTATION_TOLERANCE`], `det r > 0`).
+    /// Every engine refuses an untrusted value the same way (the receiver
+    /// keeps what it had), so they stay bit-identical even when a run
+    /// diverges.
+    pub fn trust(&self) -> Result<(), Untrusted> {
+        let all = self.r.iter().chain(self.w.iter()).chain(self.s.iter());
+        if all.clone().any(|v| !v.is_finite()) {
+            return Err(Untrusted::NonFinite);
+        }
+        let defect = crate::so3::orthogonality_defect(&self.r);
+        if defect > ROTATION_TOLERANCE || self.r.determinant() <= 0.0 {
+            return Err(Untrusted::NotARotation(defect));
+        }
+        Ok(())
+    }
+}
+
+/// Largest `‖rᵀr − I‖_F` a received attitude may have. attsync's own
+/// integrator keeps it near 1e-12; 1e-6 admits any honest f64 rotation.
+pub const ROTATION_TOLERANCE: f64 = 1e-6;
+
+/// Why a received state was refused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Untrusted {
+    /// A NaN or an infinity.
+    NonFinite,
+    /// `r` is not a rotation (its orthogonality defect, or a reflection).
+    NotARotation(f64),
+}
+
+impl std::fmt::Display for Untrusted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NonFinite => write!(f, "a value is NaN or infinite"),
+            Self::NotARotation(d) => write!(
+                f,
+                "the attitude is not a rotation (‖RᵀR − I‖ = {d:.3e}, or det R ≤ 0)"
+            ),
+        }
+    }
 }
 
 /// The paper's three schemes and their gains.

@@ -795,3 +795,51 @@ fn lossy_network_runs_are_reproducible_from_the_seed() {
         }
     }
 }
+
+// ------------------------------------------------------- untrusted values
+
+/// A NaN or a non-rotation is refused by the receiving agent, counted per
+/// link, and leaves the agent exactly as if nothing had arrived.
+#[test]
+fn untrusted_values_are_refused_counted_and_change_nothing() {
+    let net = network(true, Links::ideal(), 10);
+    let spec = &net.agents[1]; // agent 2: neighbours 1 and 3
+    let mut a = attitude::agent::Agent::new(spec.model.clone(), spec.initial, DT);
+    let mut b = a.clone();
+    let good = Exchanged {
+        r: rot(0.3, &Vector3::new(0.0, 0.6, 0.8)),
+        w: Vector3::new(0.1, -0.2, 0.3),
+        s: Vector3::zeros(),
+    };
+    let mut nan = good;
+    nan.w[1] = f64::NAN;
+    let mut skew = good;
+    skew.r[(0, 1)] += 1e-3;
+    for n in 0..10u64 {
+        for s in 0..4u32 {
+            for k in 0..2 {
+                let bad = match (n, s, k) {
+                    (3, 0, 0) => Some(nan),
+                    (6, 2, 1) => Some(skew),
+                    _ => None,
+                };
+                match bad {
+                    Some(x) => a.receive_neighbour(k, x), // refused; b hears nothing
+                    None => {
+                        a.receive_neighbour(k, good);
+                        b.receive_neighbour(k, good);
+                    }
+                }
+            }
+            a.advance();
+            b.advance();
+        }
+    }
+    assert_eq!(bits(a.state()), bits(b.state()));
+    let stats = a.link_stats();
+    assert_eq!(stats.len(), 2, "{stats:?}");
+    assert_eq!((stats[0].0, stats[0].1.rejected), (1, 1));
+    assert_eq!((stats[1].0, stats[1].1.rejected), (3, 1));
+    assert!(b.link_stats().is_empty());
+    assert!(good.trust().is_ok() && nan.trust().is_err() && skew.trust().is_err());
+}

@@ -84,16 +84,8 @@ impl StateMsg {
     /// finite and `r` a rotation (`‖rᵀr − I‖_F ≤` [`ROTATION_TOLERANCE`],
     /// `det r > 0`). Values from another process are never used unchecked.
     pub fn validated(&self) -> Result<Exchanged, Invalid> {
-        let all = self.r.iter().chain(&self.w).chain(&self.s);
-        if all.clone().any(|v| !v.is_finite()) {
-            return Err(Invalid::NonFinite);
-        }
         let x = self.exchanged();
-        let defect = attitude::so3::orthogonality_defect(&x.r);
-        if defect > ROTATION_TOLERANCE || x.r.determinant() <= 0.0 {
-            return Err(Invalid::NotARotation(defect));
-        }
-        Ok(x)
+        x.trust().map(|()| x)
     }
 
     /// The exchanged state (exact copy of the sent values).
@@ -107,30 +99,7 @@ impl StateMsg {
     }
 }
 
-/// Largest `‖rᵀr − I‖_F` a received attitude may have. attsync's own
-/// integrator keeps it near 1e-12; 1e-6 admits any honest f64 rotation.
-pub const ROTATION_TOLERANCE: f64 = 1e-6;
-
-/// Why a received state was refused.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Invalid {
-    /// A NaN or an infinity.
-    NonFinite,
-    /// `r` is not a rotation (its orthogonality defect, or a reflection).
-    NotARotation(f64),
-}
-
-impl std::fmt::Display for Invalid {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Self::NonFinite => write!(f, "a value is NaN or infinite"),
-            Self::NotARotation(d) => write!(
-                f,
-                "the attitude is not a rotation (‖RᵀR − I‖ = {d:.3e}, or det R ≤ 0)"
-            ),
-        }
-    }
-}
+pub use attitude::network::{ROTATION_TOLERANCE, Untrusted as Invalid};
 
 /// Nanoseconds since the Unix epoch, now (`CLOCK_REALTIME`).
 #[must_use]

@@ -228,7 +228,7 @@ impl Inputs {
                     (
                         from,
                         LinkStats {
-                            rejected: self.rejected[k],
+                            rejected: s.rejected + self.rejected[k],
                             ..s
                         },
                     )
