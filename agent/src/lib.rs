@@ -18,6 +18,9 @@ use iceoryx2::node::Node;
 use iceoryx2::service::Service;
 use msgs::TelemetryMsg;
 use msgs::config::{NodeConfig, Role};
+/// Runs any [`Stepper`] (your own agent model) behind the node loop: the
+/// way to write a plug-in agent in Rust (see `examples/saturated_agent/`).
+pub use runtime::run as run_stepper;
 pub use runtime::{NodeError, Stepper};
 use std::sync::atomic::AtomicBool;
 

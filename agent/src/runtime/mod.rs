@@ -30,17 +30,25 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 use tracing::{debug, info, warn};
 
-/// A node's model, seen by the loop: the leader or an agent.
+/// A node's model, seen by the loop: the leader, an agent, or a plug-in's
+/// own model. The loop calls, for every step n and stage s = 0..3: at an
+/// exchange, [`Stepper::stage_exchange`] (published stamped (n, s)) and
+/// [`Stepper::receive`] once per input; then [`Stepper::advance`]. The
+/// stepper keeps track of its own stage (four `advance` calls make a step).
 pub trait Stepper {
     /// State published at the current stage.
     fn stage_exchange(&self) -> Exchanged;
-    /// Stores the value received from input `k` (order of `NodeConfig::inputs`).
+    /// Stores the value received from input `k`: the order of
+    /// `NodeConfig::inputs`, i.e. neighbours by ascending id, then the leader
+    /// (0) if linked. Values arrive already validated (finite, a rotation).
     fn receive(&mut self, k: usize, x: Exchanged);
     /// Evaluates the current stage and moves on.
     fn advance(&mut self);
-    /// Telemetry sample of the state at the start of the current step.
+    /// Telemetry sample of the state at the start of the current step
+    /// (`TelemetryMsg::agent` for an agent).
     fn sample(&self, step: u64) -> TelemetryMsg;
-    /// Largest torque norm so far.
+    /// Largest torque norm applied so far, taken at stage 0 of each step
+    /// (as the built-in agent does), N·m.
     fn peak_torque(&self) -> f64;
     /// Counters of the impaired incoming links: (sender id, stats).
     fn link_stats(&self) -> Vec<(u32, LinkStats)> {
