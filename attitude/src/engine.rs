@@ -41,17 +41,7 @@ impl InProcess {
             .iter()
             .map(|a| Agent::new(a.model.clone(), a.initial, net.dt))
             .collect();
-        let nbr_index = net
-            .agents
-            .iter()
-            .map(|a| {
-                a.model
-                    .neighbours
-                    .iter()
-                    .map(|n| net.index_of(n.id).expect("validated network"))
-                    .collect()
-            })
-            .collect();
+        let nbr_index = net.neighbour_indices();
         let states = agents.iter().map(|a| *a.state()).collect();
         Self {
             net: net.clone(),

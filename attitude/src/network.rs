@@ -226,4 +226,21 @@ impl Network {
     pub fn index_of(&self, id: u32) -> Option<usize> {
         self.agents.iter().position(|a| a.model.id == id)
     }
+
+    /// For each agent, the index in `agents` of each of its neighbours (in
+    /// the order of its `model.neighbours`). Panics on an unvalidated network
+    /// whose neighbour ids are unknown.
+    #[must_use]
+    pub fn neighbour_indices(&self) -> Vec<Vec<usize>> {
+        self.agents
+            .iter()
+            .map(|a| {
+                a.model
+                    .neighbours
+                    .iter()
+                    .map(|n| self.index_of(n.id).expect("validated network"))
+                    .collect()
+            })
+            .collect()
+    }
 }

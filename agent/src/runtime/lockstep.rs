@@ -3,12 +3,12 @@
 //! every input's message stamped (n, s) has arrived, then advances one stage.
 
 use super::ports::Ports;
-use super::{Inputs, NodeError, Orphan, Stepper, check_origin, port};
+use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_origin, port};
 use crate::wait::Waiter;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::{StateMsg, TelemetryKind, TelemetryMsg};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 /// Steps `cfg.steps` steps in lockstep; returns the `Done` report.
@@ -25,12 +25,7 @@ pub(crate) fn run<S: Service, N: Stepper>(
     let notify = waiter.receivers_may_block();
     ports.report(stepper.sample(0))?;
     for n in 0..cfg.steps {
-        if shutdown.load(Ordering::Relaxed) {
-            return Err(NodeError::Stopped(n));
-        }
-        if n % 256 == 0 {
-            orphan.check()?;
-        }
+        before_step(n, shutdown, orphan)?;
         for s in 0..4u32 {
             if cfg.coupling.exchanges_at(n, s as usize) {
                 ports.publish(
@@ -78,10 +73,7 @@ pub(crate) fn run<S: Service, N: Stepper>(
             }
             stepper.advance();
         }
-        let done = n + 1;
-        if done % cfg.sample_every == 0 || done == cfg.steps {
-            ports.report(stepper.sample(done))?;
-        }
+        after_step(ports, cfg, stepper, n + 1)?;
     }
     Ok(TelemetryMsg::bare(
         cfg.id,

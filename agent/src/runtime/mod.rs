@@ -290,6 +290,30 @@ impl Orphan {
     }
 }
 
+/// Before step `n`: stop if told to, and (every 256 steps) if orphaned.
+pub(crate) fn before_step(n: u64, shutdown: &AtomicBool, orphan: &Orphan) -> Result<(), NodeError> {
+    if shutdown.load(Ordering::Relaxed) {
+        return Err(NodeError::Stopped(n));
+    }
+    if n % 256 == 0 {
+        orphan.check()?;
+    }
+    Ok(())
+}
+
+/// After a step: report a sample if `done` steps make one due.
+pub(crate) fn after_step<S: Service, N: Stepper>(
+    ports: &Ports<S>,
+    cfg: &NodeConfig,
+    stepper: &N,
+    done: u64,
+) -> Result<(), NodeError> {
+    if done % cfg.sample_every == 0 || done == cfg.steps {
+        ports.report(stepper.sample(done))?;
+    }
+    Ok(())
+}
+
 /// The message must be from `sender` and speak our version.
 pub(crate) fn check_origin(m: &StateMsg, sender: u32) -> Result<(), NodeError> {
     if m.version != PROTOCOL_VERSION {

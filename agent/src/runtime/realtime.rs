@@ -17,12 +17,12 @@
 //! seconds: the real transport and scheduling latency.
 
 use super::ports::Ports;
-use super::{Inputs, NodeError, Orphan, Stepper, check_origin, port};
+use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_origin, port};
 use attitude::link::LinkStats;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::{StateMsg, TelemetryKind, TelemetryMsg, unix_ns_now};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
 /// Stage offsets of RKMK4 within a step.
@@ -79,12 +79,7 @@ pub(crate) fn run<S: Service, N: Stepper>(
     let mut exchanges = 0u64;
     ports.report(stepper.sample(0))?;
     for n in 0..cfg.steps {
-        if shutdown.load(Ordering::Relaxed) {
-            return Err(NodeError::Stopped(n));
-        }
-        if n % 256 == 0 {
-            orphan.check()?;
-        }
+        before_step(n, shutdown, orphan)?;
         for s in 0..4u32 {
             let due = clock.due(n, s);
             let now = Instant::now();
@@ -151,10 +146,7 @@ pub(crate) fn run<S: Service, N: Stepper>(
             }
             stepper.advance();
         }
-        let done = n + 1;
-        if done % cfg.sample_every == 0 || done == cfg.steps {
-            ports.report(stepper.sample(done))?;
-        }
+        after_step(ports, cfg, stepper, n + 1)?;
     }
     for st in &mut inputs.measured {
         // Every node makes the same exchanges: what a sender sent is what we made.

@@ -190,17 +190,7 @@ impl Neighbourhood {
             .enumerate()
             .map(|(i, a)| (i != candidate).then(|| Agent::new(a.model.clone(), a.initial, net.dt)))
             .collect();
-        let nbr_index = net
-            .agents
-            .iter()
-            .map(|a| {
-                a.model
-                    .neighbours
-                    .iter()
-                    .map(|n| net.index_of(n.id).expect("validated network"))
-                    .collect()
-            })
-            .collect();
+        let nbr_index = net.neighbour_indices();
         Self {
             leader: Leader::new(net.p, net.leader, net.dt),
             agents,

@@ -453,17 +453,8 @@ struct Collector {
 impl Collector {
     /// Names the nodes others gave up waiting for, if any did.
     fn blame(&self, net: &Network, plugins: &[Plugin]) -> Option<String> {
-        let index_of = |id: u32| {
-            if id == 0 {
-                0
-            } else {
-                1 + net
-                    .agents
-                    .iter()
-                    .position(|a| a.model.id == id)
-                    .unwrap_or(0)
-            }
-        };
+        // Node index: 0 the leader, 1 + the agent's index.
+        let index_of = |id: u32| net.index_of(id).map_or(0, |i| i + 1);
         let mut blamed: Vec<u32> = self.blamed.iter().map(|&(_, id)| id).collect();
         blamed.sort_unstable();
         blamed.dedup();
