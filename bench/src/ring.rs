@@ -218,7 +218,8 @@ impl RingNode {
         let barrier = Duration::from_secs_f64(self.barrier_timeout);
 
         set_log_level(LogLevel::Error);
-        let cfg = msgs::namespace::config(run, &self.root.join("iox"))?;
+        let cfg =
+            msgs::namespace::config(run, &self.root.join("iox")).map_err(|e| e.to_string())?;
         let name = format!("ring_{id}");
         let node = NodeBuilder::new()
             .name(&name.as_str().try_into().map_err(port("node name"))?)
@@ -360,7 +361,7 @@ impl RingNode {
             start_unix,
             end_unix,
             elapsed,
-            peak_rss_kb: attsync_agent::runtime::peak_rss_kb(),
+            peak_rss_kb: msgs::telemetry::peak_rss_kb(),
         })
     }
 }
