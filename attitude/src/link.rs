@@ -18,10 +18,10 @@
 //! message means the receiver keeps what it had. Before the first delivery
 //! the receiver holds the first valid message it was offered, normally the
 //! sender's state at t = 0 (the history of a delayed system before t = 0 is
-//! its initial state). `PROTOCOL.md` § 10.9 states all this for plug-ins. With a constant delay of k
-//! steps the receiver uses at stage s of step n exactly the sender's stage-s
-//! state of step n − k: RK4 applied to the delay equation by the method of
-//! steps.
+//! its initial state). With a constant delay of k steps the receiver uses
+//! at stage s of step n exactly the sender's stage-s state of step n − k:
+//! RK4 applied to the delay equation by the method of steps.
+//! `PROTOCOL.md` § 10.9 states all this for plug-ins.
 //!
 //! A link without impairments is not filtered at all, so an unimpaired run
 //! stays byte-identical to the plain engine.
