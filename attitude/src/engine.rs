@@ -7,6 +7,7 @@
 use crate::agent::Agent;
 use crate::network::{AgentState, Network};
 use crate::reference::{Leader, LeaderState};
+use crate::schedule::Schedule;
 
 /// The network's state at an output sample.
 #[derive(Debug)]
@@ -79,8 +80,8 @@ impl InProcess {
     /// coupling says).
     pub fn step(&mut self) {
         let mut published = Vec::with_capacity(self.agents.len());
-        for stage in 0..4 {
-            if self.net.coupling.exchanges_at(self.step, stage) {
+        for slot in Schedule::new(self.net.coupling, self.net.steps).stages(self.step) {
+            if slot.exchange {
                 let from_leader = self.leader.stage_exchange();
                 published.clear();
                 published.extend(self.agents.iter().map(Agent::stage_exchange));

@@ -18,6 +18,7 @@
 //! - [`network`]: the resolved network every engine runs.
 //! - [`link`]: delay, jitter, loss and per-link period, on the receiving side.
 //! - [`agent`]: one follower as a stage-by-stage stepper (the exchange protocol).
+//! - [`schedule`]: the stages `(n, s)` of a run and which are exchanges (every loop walks it).
 //! - [`engine`]: all nodes in one process, in lockstep.
 //! - [`metrics`]: the reported errors.
 //! - [`checks`]: the paper's conditions on gains and on `P`.
@@ -33,4 +34,5 @@ pub mod metrics;
 pub mod network;
 pub mod observer;
 pub mod reference;
+pub mod schedule;
 pub mod so3;

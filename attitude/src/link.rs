@@ -155,9 +155,6 @@ impl Ord for InFlight {
     }
 }
 
-/// Stage time as a fraction of a step.
-const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
-
 /// The receiving end of an impaired link.
 #[derive(Debug, Clone)]
 pub struct Link {
@@ -237,7 +234,8 @@ impl Link {
             }
         }
         let (hm, hs, x) = self.held?;
-        let age = ((n as f64 + C[s as usize]) - (hm as f64 + C[hs as usize])) * dt;
+        let c = crate::integrate::stage_time_fraction;
+        let age = ((n as f64 + c(s as usize)) - (hm as f64 + c(hs as usize))) * dt;
         self.stats.age_sum += age;
         self.stats.age_max = self.stats.age_max.max(age);
         self.stats.evaluations += 1;
