@@ -1,62 +1,39 @@
 //! Scenario files: format ([`schema`]), `--set` overrides ([`overrides`]),
 //! validation and resolution into the model's network ([`resolve`]).
+//!
+//! [`load`] reads the file ([`input`]: size limit, bounded read), parses it
+//! and applies the overrides, deserialises it collecting every schema problem
+//! ([`deserialize`]), then checks what the paper assumes ([`resolve`],
+//! [`plugin`]). Every problem of a stage is reported at once
+//! ([`ScenarioError`]).
+//!
+//! # Layout
+//! - [`schema`] — the file format as serde types;
+//! - [`input`] — reading a file within [`input::MAX_FILE_BYTES`]; quotes of
+//!   the input clipped;
+//! - [`overrides`] — `--set key.path=value`;
+//! - `parse` — text + overrides → document and [`Scenario`], every problem at once;
+//! - [`deserialize`] — the document → [`Scenario`], every schema problem;
+//! - [`resolve`] — validation and resolution into the network, one phase per table;
+//! - [`plugin`] — plug-in agents (`[[agent]] command`);
+//! - [`report`] — the text `attsync check` prints;
+//! - `error` — [`ScenarioError`].
 
+pub mod deserialize;
+mod error;
+pub mod input;
 pub mod overrides;
+mod parse;
 pub mod plugin;
 pub mod report;
 pub mod resolve;
 pub mod schema;
 
+pub use error::ScenarioError;
 pub use resolve::{Issue, Resolved};
 pub use schema::Scenario;
 
 use std::path::{Path, PathBuf};
-use thiserror::Error;
-
-/// Why a scenario could not be loaded.
-#[derive(Debug, Error)]
-pub enum ScenarioError {
-    /// The file could not be read.
-    #[error("{file}: cannot read: {source}")]
-    Io {
-        /// The scenario file.
-        file: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
-    },
-    /// Not valid TOML, or a field of the wrong type, or an unknown key.
-    #[error("{file}: {message}")]
-    Parse {
-        /// The scenario file.
-        file: PathBuf,
-        /// The parser's message (with line, column and key).
-        message: String,
-    },
-    /// A `--set` override could not be applied.
-    #[error("{file}: --set {message}")]
-    Override {
-        /// The scenario file.
-        file: PathBuf,
-        /// What is wrong with the override.
-        message: String,
-    },
-    /// The scenario parsed but breaks the model's assumptions.
-    #[error("{}", fmt_issues(file, issues))]
-    Invalid {
-        /// The scenario file.
-        file: PathBuf,
-        /// Every problem found.
-        issues: Vec<Issue>,
-    },
-}
-
-fn fmt_issues(file: &Path, issues: &[Issue]) -> String {
-    issues
-        .iter()
-        .map(|i| format!("{}: {i}", file.display()))
-        .collect::<Vec<_>>()
-        .join("\n")
-}
 
 /// A scenario as loaded: the effective document (after overrides), its
 /// typed form and its resolved network.
@@ -85,38 +62,41 @@ impl Loaded {
     }
 }
 
-/// Reads, overrides, parses and validates a scenario file.
+/// Reads (at most [`input::MAX_FILE_BYTES`]), overrides, parses and
+/// validates a scenario file.
 pub fn load(file: &Path, overrides: &[String]) -> Result<Loaded, ScenarioError> {
-    let text = std::fs::read_to_string(file).map_err(|source| ScenarioError::Io {
+    let text = input::read_bounded(file).map_err(|error| ScenarioError::Io {
         file: file.to_owned(),
-        source,
+        error,
     })?;
     load_str(file, &text, overrides)
 }
 
 /// As [`load`], from text already read (`file` is used in messages).
 pub fn load_str(file: &Path, text: &str, overrides: &[String]) -> Result<Loaded, ScenarioError> {
-    let parse = |message: String| ScenarioError::Parse {
-        file: file.to_owned(),
-        message,
-    };
-    let mut document: toml::Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| parse(e.to_string()))?;
-    for o in overrides {
-        overrides::apply(&mut document, o).map_err(|message| ScenarioError::Override {
-            file: file.to_owned(),
-            message,
-        })?;
-    }
-    // Without overrides, parse the text itself so messages carry line and
-    // column; with them, parse the edited document and name the field path.
-    let scenario = if overrides.is_empty() {
-        toml::from_str::<Scenario>(text).map_err(|e| parse(e.to_string()))?
-    } else {
-        serde_path_to_error::deserialize(toml::Value::Table(document.clone()))
-            .map_err(|e| parse(format!("{}: {}", e.path(), e.inner())))?
-    };
+    let file_buf = file.to_owned();
+    let (document, scenario) = parse::parse(text, overrides).map_err(|f| match f {
+        parse::Failure::Syntax(issue) => ScenarioError::Parse {
+            file: file_buf.clone(),
+            issues: vec![issue],
+        },
+        parse::Failure::Schema { overrides, schema } if overrides.is_empty() => {
+            ScenarioError::Parse {
+                file: file_buf.clone(),
+                issues: schema,
+            }
+        }
+        parse::Failure::Schema {
+            mut overrides,
+            schema,
+        } => {
+            overrides.extend(schema);
+            ScenarioError::Override {
+                file: file_buf.clone(),
+                issues: overrides,
+            }
+        }
+    })?;
     let dir = match file.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
         _ => PathBuf::from("."),

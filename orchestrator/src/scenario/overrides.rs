@@ -6,13 +6,51 @@
 //! `simulation.duration=10`, `scheme.kind="observerless"`. The value is read
 //! as a TOML value; if that fails it is taken as a string (`scheme.kind=observerless`).
 
+use thiserror::Error;
 use toml::{Table, Value};
 
+/// Why one `--set` override could not be applied.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum OverrideError {
+    /// There is no `=` between the key path and the value.
+    #[error("expected key.path=value")]
+    NoEquals,
+    /// The key path is empty.
+    #[error("empty key path")]
+    EmptyPath,
+    /// A segment of the path is neither `key` nor `key[index]`.
+    #[error("bad path segment `{0}`")]
+    BadSegment(String),
+    /// The path goes through a value that is not a table.
+    #[error("`{0}` is not a table")]
+    NotATable(String),
+    /// An index is applied to a value that is not an array.
+    #[error("`{0}` is not an array")]
+    NotAnArray(String),
+    /// The indexed array does not exist.
+    #[error("no array `{0}`")]
+    NoArray(String),
+    /// The index is past the end of the array.
+    #[error("`{key}[{index}]`: index out of range (it has {len} elements)")]
+    OutOfRange {
+        /// The array's key.
+        key: String,
+        /// The index asked for.
+        index: usize,
+        /// The array's length.
+        len: usize,
+    },
+}
+
+/// The key path of an override (`agent[2].omega` of `agent[2].omega=[0, 0, 1]`).
+#[must_use]
+pub fn path_of(spec: &str) -> Option<&str> {
+    spec.split_once('=').map(|(path, _)| path.trim())
+}
+
 /// Applies one `key.path=value` override to `doc`.
-pub fn apply(doc: &mut Table, spec: &str) -> Result<(), String> {
-    let (path, raw) = spec
-        .split_once('=')
-        .ok_or_else(|| format!("`{spec}`: expected key.path=value"))?;
+pub fn apply(doc: &mut Table, spec: &str) -> Result<(), OverrideError> {
+    let (path, raw) = spec.split_once('=').ok_or(OverrideError::NoEquals)?;
     let value = parse_value(raw.trim());
     let segments = parse_path(path.trim())?;
     let (last, parents) = segments
@@ -29,14 +67,14 @@ pub fn apply(doc: &mut Table, spec: &str) -> Result<(), String> {
         };
         table = entry
             .as_table_mut()
-            .ok_or_else(|| format!("`{path}`: `{key}` is not a table"))?;
+            .ok_or_else(|| OverrideError::NotATable(key.clone()))?;
     }
     let (key, index) = last;
     match index {
         Some(k) => {
             let entry = table
                 .get_mut(key)
-                .ok_or_else(|| format!("`{path}`: no array `{key}`"))?;
+                .ok_or_else(|| OverrideError::NoArray(key.clone()))?;
             *index_into(entry, key, *k)? = value;
         }
         None => {
@@ -46,13 +84,16 @@ pub fn apply(doc: &mut Table, spec: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn index_into<'a>(v: &'a mut Value, key: &str, k: usize) -> Result<&'a mut Value, String> {
+fn index_into<'a>(v: &'a mut Value, key: &str, k: usize) -> Result<&'a mut Value, OverrideError> {
     let arr = v
         .as_array_mut()
-        .ok_or_else(|| format!("`{key}` is not an array"))?;
-    let n = arr.len();
-    arr.get_mut(k)
-        .ok_or_else(|| format!("`{key}[{k}]`: index out of range (it has {n} elements)"))
+        .ok_or_else(|| OverrideError::NotAnArray(key.to_owned()))?;
+    let len = arr.len();
+    arr.get_mut(k).ok_or_else(|| OverrideError::OutOfRange {
+        key: key.to_owned(),
+        index: k,
+        len,
+    })
 }
 
 fn parse_value(raw: &str) -> Value {
@@ -63,13 +104,13 @@ fn parse_value(raw: &str) -> Value {
         .unwrap_or_else(|| Value::String(raw.to_string()))
 }
 
-fn parse_path(path: &str) -> Result<Vec<(String, Option<usize>)>, String> {
+fn parse_path(path: &str) -> Result<Vec<(String, Option<usize>)>, OverrideError> {
     if path.is_empty() {
-        return Err("empty key path in --set".into());
+        return Err(OverrideError::EmptyPath);
     }
     path.split('.')
         .map(|seg| {
-            let bad = || format!("`{path}`: bad path segment `{seg}`");
+            let bad = || OverrideError::BadSegment(seg.to_owned());
             match seg.split_once('[') {
                 None if !seg.is_empty() => Ok((seg.to_string(), None)),
                 None => Err(bad()),
@@ -104,6 +145,7 @@ mod tests {
         assert!(
             apply(&mut t, "agent[5].id=3")
                 .unwrap_err()
+                .to_string()
                 .contains("out of range")
         );
         assert!(apply(&mut t, "no_equals").is_err());

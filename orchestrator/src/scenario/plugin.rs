@@ -4,6 +4,7 @@ use super::resolve::Issue;
 use super::schema::Scenario;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use thiserror::Error;
 
 /// An agent run by a program of the user's instead of `attsync-agent`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -50,7 +51,7 @@ pub fn resolve(s: &Scenario, dir: &Path) -> Result<Vec<Plugin>, Vec<Issue>> {
             Some(p) if p.trim().is_empty() => err(format!("{f}[0]"), "the program is empty".into()),
             Some(p) => {
                 if let Err(reason) = find_program(p, dir) {
-                    err(format!("{f}[0]"), reason);
+                    err(format!("{f}[0]"), reason.to_string());
                 }
             }
         }
@@ -77,17 +78,33 @@ pub fn resolve(s: &Scenario, dir: &Path) -> Result<Vec<Plugin>, Vec<Issue>> {
     }
 }
 
+/// Why a plug-in's program cannot be found.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum FindProgramError {
+    /// A program named with a `/` is not a file under the scenario's directory.
+    #[error("{program}: no such file (relative paths are taken from the scenario's directory {})", dir.display())]
+    NoSuchFile {
+        /// The program as written.
+        program: String,
+        /// The scenario's directory.
+        dir: PathBuf,
+    },
+    /// A bare program name is not on `PATH`.
+    #[error("{0}: not found on PATH")]
+    NotOnPath(String),
+}
+
 /// Where `program` would be found.
-fn find_program(program: &str, dir: &Path) -> Result<PathBuf, String> {
+fn find_program(program: &str, dir: &Path) -> Result<PathBuf, FindProgramError> {
     if program.contains('/') {
         let p = dir.join(program);
         return if p.is_file() {
             Ok(p)
         } else {
-            Err(format!(
-                "{program}: no such file (relative paths are taken from the scenario's directory {})",
-                dir.display()
-            ))
+            Err(FindProgramError::NoSuchFile {
+                program: program.to_owned(),
+                dir: dir.to_owned(),
+            })
         };
     }
     std::env::var_os("PATH")
@@ -95,5 +112,5 @@ fn find_program(program: &str, dir: &Path) -> Result<PathBuf, String> {
         .flat_map(std::env::split_paths)
         .map(|d| d.join(program))
         .find(|p| p.is_file())
-        .ok_or_else(|| format!("{program}: not found on PATH"))
+        .ok_or_else(|| FindProgramError::NotOnPath(program.to_owned()))
 }

@@ -1,0 +1,140 @@
+//! Text → effective document (after `--set`) → typed [`Scenario`], with
+//! every problem of the overrides and of the schema found in one pass.
+
+use super::deserialize::{self, DocPath, Kind, Problem, Seg};
+use super::input::{MAX_QUOTE_CHARS, clip, locate};
+use super::overrides;
+use super::resolve::Issue;
+use super::schema::Scenario;
+use toml::Table;
+use toml::de::{DeArray, DeTable};
+
+/// Most characters of a reason (serde's messages list the expected keys).
+const MAX_REASON_CHARS: usize = 600;
+
+/// Why a text and its overrides do not make a scenario.
+pub(super) enum Failure {
+    /// The text is not TOML (nothing else can be checked).
+    Syntax(Issue),
+    /// `--set` overrides that could not be applied, and the problems of the
+    /// document (with the other overrides applied) against the schema.
+    Schema {
+        /// One per bad override, in command-line order.
+        overrides: Vec<Issue>,
+        /// Unknown keys, wrong types, missing fields.
+        schema: Vec<Issue>,
+    },
+}
+
+/// The effective document and its typed form.
+pub(super) fn parse(text: &str, sets: &[String]) -> Result<(Table, Scenario), Failure> {
+    let mut document: Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| Failure::Syntax(syntax(text, &e)))?;
+    let mut bad = Vec::new();
+    let mut applied = Vec::new();
+    for o in sets {
+        // On a copy, so that a half-applied override leaves nothing behind.
+        let mut next = document.clone();
+        match overrides::apply(&mut next, o) {
+            Ok(()) => {
+                document = next;
+                applied.extend(overrides::path_of(o));
+            }
+            Err(e) => bad.push(Issue {
+                field: format!("--set {}", clip(o, MAX_QUOTE_CHARS)),
+                reason: e.to_string(),
+            }),
+        }
+    }
+    match deserialize::deserialize(&document) {
+        Ok(s) if bad.is_empty() => Ok((document, s)),
+        Ok(_) => Err(Failure::Schema {
+            overrides: bad,
+            schema: Vec::new(),
+        }),
+        Err(problems) => {
+            let spans = DeTable::parse(text).ok();
+            let schema = problems
+                .iter()
+                .map(|p| issue(text, spans.as_ref().map(|s| s.get_ref()), &applied, p))
+                .collect();
+            Err(Failure::Schema {
+                overrides: bad,
+                schema,
+            })
+        }
+    }
+}
+
+/// A TOML syntax error as `line L, column C: reason: `the line``.
+fn syntax(text: &str, e: &toml::de::Error) -> Issue {
+    let reason = clip(e.message().trim(), MAX_REASON_CHARS);
+    match e.span() {
+        Some(span) => {
+            let (line, col, quote) = locate(text, span.start);
+            Issue {
+                field: format!("line {line}, column {col}"),
+                reason: format!("{reason}: `{quote}`"),
+            }
+        }
+        None => Issue {
+            field: "TOML".into(),
+            reason,
+        },
+    }
+}
+
+/// A schema problem as an issue on its field, with its place in the text
+/// when the field is as written there (not set by an override).
+fn issue(text: &str, spans: Option<&DeTable>, applied: &[&str], p: &Problem) -> Issue {
+    let field = p.path.to_string();
+    let overridden = applied.iter().any(|a| {
+        field == *a
+            || field
+                .strip_prefix(a)
+                .is_some_and(|rest| rest.starts_with(['.', '[']))
+    });
+    let at = match p.kind {
+        Kind::Missing => DocPath(p.path.0[..p.path.0.len() - 1].to_vec()),
+        _ => p.path.clone(),
+    };
+    let place = spans
+        .filter(|_| !overridden)
+        .and_then(|s| offset(s, &at.0, p.kind == Kind::UnknownKey))
+        .map(|o| {
+            let (line, col, _) = locate(text, o);
+            format!(" (line {line}, column {col})")
+        })
+        .unwrap_or_default();
+    Issue {
+        field: clip(&field, MAX_QUOTE_CHARS),
+        reason: format!("{}{place}", clip(&p.message, MAX_REASON_CHARS)),
+    }
+}
+
+/// Byte offset in the text of the value at `path` (of its key, if `at_key`).
+fn offset(root: &DeTable, path: &[Seg], at_key: bool) -> Option<usize> {
+    let (mut table, mut array) = (Some(root), None);
+    let mut at = None;
+    for (i, s) in path.iter().enumerate() {
+        let last = i + 1 == path.len();
+        let v = match s {
+            Seg::Key(name) => {
+                let (k, v) = table?
+                    .iter()
+                    .find(|(k, _)| k.get_ref().as_ref() == name.as_str())?;
+                at = Some(if at_key && last { k.span() } else { v.span() }.start);
+                v
+            }
+            Seg::Index(n) => {
+                let v = array.and_then(|a: &DeArray| a.get(*n))?;
+                at = Some(v.span().start);
+                v
+            }
+        };
+        table = v.get_ref().as_table();
+        array = v.get_ref().as_array();
+    }
+    at
+}

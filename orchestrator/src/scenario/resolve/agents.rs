@@ -1,0 +1,128 @@
+//! `[[agent]]`: ids, bodies, initial states and control gains `Āᵢ`.
+
+use super::ctx::Ctx;
+use super::kind_name;
+use crate::scenario::schema::{AgentSpec, ObserverInit, SchemeKind};
+use attitude::body::Inertia;
+use attitude::network::AgentState;
+use nalgebra::{Matrix3, Vector3};
+use std::collections::BTreeMap;
+
+/// An agent's body, `Āᵢ` and initial state.
+pub(super) type Body = (Inertia, Matrix3<f64>, AgentState);
+
+/// The observer's initial state `(R̂ᵢ, ω̂ᵢ, σ̂ᵢ)`.
+type ObserverState = (Matrix3<f64>, Vector3<f64>, Vector3<f64>);
+
+/// Agent id → its index in `[[agent]]` (the first, if repeated).
+pub(super) fn ids(c: &mut Ctx, agents: &[AgentSpec]) -> BTreeMap<u32, usize> {
+    let mut ids: BTreeMap<u32, usize> = BTreeMap::new();
+    for (k, a) in agents.iter().enumerate() {
+        if a.id == 0 {
+            c.err(format!("agent[{k}].id"), "must be ≥ 1 (id 0 is the leader)");
+        } else if let Some(first) = ids.insert(a.id, k) {
+            c.err(
+                format!("agent[{k}].id"),
+                format!("duplicate id {} (also agent[{first}])", a.id),
+            );
+            ids.insert(a.id, first);
+        }
+    }
+    if agents.is_empty() {
+        c.err("agent", "at least one [[agent]] is required");
+    }
+    ids
+}
+
+/// Every valid agent's body, by id.
+pub(super) fn bodies(c: &mut Ctx, agents: &[AgentSpec], kind: SchemeKind) -> BTreeMap<u32, Body> {
+    let mut bodies = BTreeMap::new();
+    for (k, a) in agents.iter().enumerate() {
+        if let Some(b) = body(c, &format!("agent[{k}]"), a, kind) {
+            bodies.insert(a.id, b);
+        }
+    }
+    bodies
+}
+
+/// Agent `a` (at field `f`), or `None` if any of its fields is invalid.
+fn body(c: &mut Ctx, f: &str, a: &AgentSpec, kind: SchemeKind) -> Option<Body> {
+    let j = c.spd(&format!("{f}.inertia"), &a.inertia, "the inertia J");
+    let r = c.rotation(&format!("{f}.attitude"), &a.attitude);
+    let w = c.vec3(&format!("{f}.omega"), &a.omega);
+    let (a_bar, obs) = if kind == SchemeKind::Observerless {
+        for (set, name) in [
+            (a.control_gain.is_some(), "control_gain"),
+            (a.observer.is_some(), "observer"),
+        ] {
+            if set {
+                c.warn(format!("{f}.{name}"), "ignored by the observerless scheme");
+            }
+        }
+        (
+            Some(Matrix3::identity()),
+            Some((Matrix3::identity(), Vector3::zeros(), Vector3::zeros())),
+        )
+    } else {
+        let a_bar = match &a.control_gain {
+            Some(m) => c.gain(&format!("{f}.control_gain"), m),
+            None => {
+                c.err(
+                    format!("{f}.control_gain"),
+                    format!("Āᵢ is required by scheme {}", kind_name(kind)),
+                );
+                None
+            }
+        };
+        (a_bar, observer(c, f, a.observer.as_ref(), kind))
+    };
+    let (j, r, a_bar, (r_hat, w_hat, s_hat)) = (j?, r?, a_bar?, obs?);
+    let initial = AgentState {
+        r,
+        w,
+        r_hat,
+        w_hat,
+        s_hat,
+    };
+    Some((Inertia::new(j), a_bar, initial))
+}
+
+/// The observer's initial state of agent `f` under a scheme with an observer.
+fn observer(
+    c: &mut Ctx,
+    f: &str,
+    o: Option<&ObserverInit>,
+    kind: SchemeKind,
+) -> Option<ObserverState> {
+    let Some(o) = o else {
+        c.err(
+            format!("{f}.observer"),
+            format!(
+                "the observer's initial state is required by scheme {}",
+                kind_name(kind)
+            ),
+        );
+        return None;
+    };
+    let rh = c.rotation(&format!("{f}.observer.attitude"), &o.attitude);
+    let wh = c.vec3(&format!("{f}.observer.omega"), &o.omega);
+    let sh = match (&o.sigma, kind) {
+        (Some(sg), SchemeKind::ObserverTimeVarying) => c.vec3(&format!("{f}.observer.sigma"), sg),
+        (None, SchemeKind::ObserverTimeVarying) => {
+            c.err(
+                format!("{f}.observer.sigma"),
+                "σ̂ᵢ(0) is required by scheme observer-time-varying",
+            );
+            Vector3::zeros()
+        }
+        (Some(_), _) => {
+            c.warn(
+                format!("{f}.observer.sigma"),
+                "ignored: observer 16a-16b has no σ̂",
+            );
+            Vector3::zeros()
+        }
+        (None, _) => Vector3::zeros(),
+    };
+    rh.map(|rh| (rh, wh, sh))
+}

@@ -1,0 +1,100 @@
+//! Checks on the whole graph: every agent reachable from the leader
+//! (Assumption 1), the spectrum of `Ξ + LLᵀ` and Theorem 1's gain condition
+//! (Appendix D).
+
+use super::ctx::Ctx;
+use super::graph::{Edges, LeaderLinks};
+use attitude::checks::{appendix_d_min_eigenvalue, xi_plus_laplacian};
+use attitude::network::Scheme;
+use nalgebra::{DMatrix, Matrix3};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Every agent of `ids` must be reachable from the leader through edges
+/// (checked only when there is a leader link at all).
+pub(super) fn reachability(
+    c: &mut Ctx,
+    ids: &BTreeMap<u32, usize>,
+    edges: &Edges,
+    links: &LeaderLinks,
+    any_link: bool,
+) {
+    let mut adj: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    for &(a, b) in &edges.pairs {
+        adj.entry(a).or_default().push(b);
+        adj.entry(b).or_default().push(a);
+    }
+    let mut reached: BTreeSet<u32> = links.seen.keys().copied().collect();
+    let mut stack: Vec<u32> = reached.iter().copied().collect();
+    while let Some(x) = stack.pop() {
+        for &y in adj.get(&x).map(Vec::as_slice).unwrap_or(&[]) {
+            if reached.insert(y) {
+                stack.push(y);
+            }
+        }
+    }
+    if !any_link {
+        return;
+    }
+    for (&id, &k) in ids {
+        if !reached.contains(&id) {
+            c.err(
+                format!("agent[{k}]"),
+                format!("agent {id} is not reachable from the leader: no [[leader_link]] in its connected component (Assumption 1)"),
+            );
+        }
+    }
+}
+
+/// What the graph's matrices say.
+pub(super) struct Spectrum {
+    /// Eigenvalues of `Ξ + LLᵀ`, ascending.
+    pub(super) eigenvalues: Vec<f64>,
+    /// Smallest eigenvalue of Appendix D's `F` (scheme 1 without errors).
+    pub(super) appendix_d_min_eig: Option<f64>,
+}
+
+/// The spectrum of `Ξ + LLᵀ`, and (scheme 1, only on a consistent
+/// scenario) Appendix D's condition, a warning when it fails.
+pub(super) fn spectrum(
+    c: &mut Ctx,
+    ids: &BTreeMap<u32, usize>,
+    edges: &Edges,
+    links: &LeaderLinks,
+    scheme: Option<&Scheme>,
+    p: &Matrix3<f64>,
+) -> Spectrum {
+    let index: BTreeMap<u32, usize> = ids.keys().enumerate().map(|(i, &id)| (id, i)).collect();
+    let idx_edges: Vec<(usize, usize)> = edges
+        .pairs
+        .iter()
+        .map(|(a, b)| (index[a], index[b]))
+        .collect();
+    let xi: Vec<bool> = ids.keys().map(|id| links.seen.contains_key(id)).collect();
+    let f1 = xi_plus_laplacian(ids.len(), &idx_edges, &xi);
+    let mut appendix_d_min_eig = None;
+    if let Some(Scheme::ObserverTimeVarying { observer, .. }) = scheme {
+        if c.errors.is_empty() {
+            let m = appendix_d_min_eigenvalue(&f1, observer.k_w, observer.k_sigma, p);
+            appendix_d_min_eig = Some(m);
+            if m <= 0.0 {
+                c.warn(
+                    "scheme.observer",
+                    format!("the sufficient gain condition of Theorem 1 fails: the matrix F of Appendix D is not positive definite (smallest eigenvalue {m:.3e}); convergence is not guaranteed (raise k_omega or k_sigma)"),
+                );
+            }
+        }
+    }
+    Spectrum {
+        eigenvalues: sorted_eigs(&f1),
+        appendix_d_min_eig,
+    }
+}
+
+fn sorted_eigs(m: &DMatrix<f64>) -> Vec<f64> {
+    if m.nrows() == 0 {
+        return Vec::new();
+    }
+    let mut e: Vec<f64> = m.clone().symmetric_eigenvalues().iter().copied().collect();
+    e.sort_by(f64::total_cmp);
+    e
+}

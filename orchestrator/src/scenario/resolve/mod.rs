@@ -1,0 +1,117 @@
+//! Scenario → [`Network`]: converts units and representations, and checks
+//! everything the paper assumes before anything runs. Every problem is an
+//! [`Issue`] naming the field (TOML path, 0-based array index) and the reason.
+//!
+//! [`resolve`] runs one phase per table, each collecting its problems in a
+//! shared context; messages come in the order of the phases below.
+//!
+//! # Layout
+//! - `ctx` — the context (errors, warnings) and the checks tables share
+//!   (finite, SPD, gain matrices, multiples of `dt`); `rotation` — rotation specs;
+//! - `simulation` — `name`, `[simulation]`, `[output]`;
+//! - `scheme` — `[scheme]`; `leader` — `[leader]`; `agents` — `[[agent]]`;
+//! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check);
+//! - `checks` — reachability from the leader, spectrum, Appendix D;
+//! - `network` — `[network]`, `[[network.link]]`;
+//! - `assemble` — the [`Network`] from the parts, once there are no errors.
+
+mod agents;
+mod assemble;
+mod checks;
+mod ctx;
+mod graph;
+mod leader;
+mod network;
+mod rotation;
+mod scheme;
+mod simulation;
+
+use super::schema::{Scenario, SchemeKind};
+use attitude::network::Network;
+use ctx::Ctx;
+use std::collections::BTreeMap;
+use std::fmt;
+
+/// One problem in a scenario: the field and what is wrong with it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Issue {
+    /// TOML path, e.g. `edge[2].gain` (arrays 0-based, in file order).
+    pub field: String,
+    /// Why it is wrong.
+    pub reason: String,
+}
+
+impl fmt::Display for Issue {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.field, self.reason)
+    }
+}
+
+/// A validated scenario, ready to run.
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    /// The network every engine runs.
+    pub network: Network,
+    /// Problems that do not stop a run (e.g. the gain condition of Appendix D).
+    pub warnings: Vec<Issue>,
+    /// Follower edges as agent-id pairs (smaller id first), in file order.
+    pub edges: Vec<(u32, u32)>,
+    /// Agents that hear the leader, ascending.
+    pub leader_links: Vec<u32>,
+    /// Eigenvalues of `Ξ + LLᵀ`, ascending.
+    pub spectrum: Vec<f64>,
+    /// Smallest eigenvalue of Appendix D's `F` (scheme 1 only).
+    pub appendix_d_min_eig: Option<f64>,
+    /// Agents run by the user's own programs.
+    pub plugins: Vec<super::plugin::Plugin>,
+}
+
+/// Validates `s` and resolves it into a [`Network`]. Returns every error
+/// found (not only the first).
+pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
+    let mut c = Ctx::default();
+    let kind = s.scheme.kind;
+    simulation::name(&mut c, s.name.as_ref());
+    let time = simulation::simulation(&mut c, &s.simulation, &s.output);
+    let scheme = scheme::scheme(&mut c, &s.scheme);
+    let leader = leader::leader(&mut c, &s.leader, kind);
+    let ids = agents::ids(&mut c, &s.agents);
+    let bodies = agents::bodies(&mut c, &s.agents, kind);
+    let edges = graph::edges(&mut c, &s.edges, &ids);
+    let links = graph::leader_links(&mut c, &s.leader_links, &ids);
+    checks::reachability(&mut c, &ids, &edges, &links, !s.leader_links.is_empty());
+    let spectrum = checks::spectrum(&mut c, &ids, &edges, &links, scheme.as_ref(), &leader.p);
+    let impaired = if time.dt > 0.0 && time.dt.is_finite() {
+        network::network(&mut c, &s.network, time.dt, &edges, &links)
+    } else {
+        BTreeMap::new()
+    };
+    if !c.errors.is_empty() {
+        return Err(c.errors);
+    }
+    let parts = assemble::Parts {
+        scheme,
+        time,
+        leader,
+        bodies,
+        impaired,
+    };
+    Ok(Resolved {
+        network: assemble::network(parts, &edges, &links),
+        warnings: c.warnings,
+        leader_links: links.gain.keys().copied().collect(),
+        edges: edges.pairs,
+        spectrum: spectrum.eigenvalues,
+        appendix_d_min_eig: spectrum.appendix_d_min_eig,
+        plugins: Vec::new(),
+    })
+}
+
+/// The name of a scheme as written in scenario files.
+pub fn kind_name(k: SchemeKind) -> &'static str {
+    match k {
+        SchemeKind::ObserverTimeVarying => "observer-time-varying",
+        SchemeKind::ObserverConstant => "observer-constant",
+        SchemeKind::Observerless => "observerless",
+    }
+}
