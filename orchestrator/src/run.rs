@@ -335,3 +335,51 @@ fn progress_bar(enabled: bool, steps: u64, dt: f64) -> ProgressBar {
     );
     ProgressBar::new(steps).with_style(style)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn options(out: PathBuf) -> RunOptions {
+        RunOptions {
+            engine: Engine::InProcess,
+            out,
+            processes: ProcessOptions::default(),
+            progress: false,
+        }
+    }
+
+    #[test]
+    fn stage_timeout_and_realtime_are_checked() {
+        assert_eq!(options(PathBuf::new()).validate(), Ok(()));
+        for t in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300] {
+            let mut o = options(PathBuf::new());
+            o.processes.stage_timeout = t;
+            let e = o.validate().unwrap_err();
+            assert!(e.to_string().starts_with("--stage-timeout"), "{e}");
+        }
+        for f in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300] {
+            let mut o = options(PathBuf::new());
+            o.processes.realtime = Some(f);
+            let e = o.validate().unwrap_err();
+            assert!(e.to_string().starts_with("--realtime"), "{e}");
+        }
+    }
+
+    #[test]
+    fn an_interrupted_run_keeps_its_results_and_names_the_signal() {
+        let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/timevarying.toml");
+        let loaded = crate::scenario::load(&file, &["simulation.duration=0.1".into()]).expect("valid");
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let interrupt = Interrupt::new();
+        interrupt.trigger(signal_hook::consts::SIGHUP);
+        let out = tmp.path().join("out");
+        let s = run(&loaded, &options(out.clone()), &interrupt).expect("results");
+        assert!(!s.complete);
+        assert_eq!(s.incomplete_reason.as_deref(), Some("interrupted by SIGHUP"));
+        assert_eq!(verdict(&s, &interrupt), Err(RunEnd::Interrupted(1)));
+        assert!(out.join("summary.json").is_file() && out.join("errors.csv").is_file());
+        let done = run(&loaded, &options(out), &Interrupt::new()).expect("results");
+        assert_eq!(verdict(&done, &Interrupt::new()), Ok(()));
+    }
+}

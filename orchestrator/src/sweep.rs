@@ -493,3 +493,98 @@ fn plot(file: &Path, param: &str, rows: &[SweepRow]) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     root.present().map_err(|e| e.to_string())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::processes::ProcessOptions;
+    use crate::run::Engine;
+
+    fn paper() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/constant-observerless.toml")
+    }
+
+    fn options() -> SweepOptions {
+        SweepOptions {
+            scenario: paper(),
+            param: "network.delay".into(),
+            values: vec!["0".into(), "0.1".into()],
+            jobs: 2,
+            set: Vec::new(),
+            run: RunOptions {
+                engine: Engine::InProcess,
+                out: PathBuf::from("unused"),
+                processes: ProcessOptions::default(),
+                progress: false,
+            },
+            tolerance: 1e-3,
+            find_margin: Some(Bisection {
+                iterations: 8,
+                quantum: None,
+            }),
+        }
+    }
+
+    #[test]
+    fn timing_fields_default_to_the_step_as_quantum() {
+        assert_eq!(default_quantum("network.delay", 1e-3), Some(1e-3));
+        assert_eq!(default_quantum("network.jitter", 1e-3), Some(1e-3));
+        assert_eq!(default_quantum("edge[0].period", 2e-3), Some(2e-3));
+        assert_eq!(default_quantum("network.loss", 1e-3), None);
+        assert_eq!(default_quantum("scheme.control.k_r", 1e-3), None);
+    }
+
+    #[test]
+    fn bisection_points_are_clean_multiples_of_the_quantum() {
+        assert_eq!(quantise(0.123_456, 1e-3), 0.123);
+        assert_eq!(quantise(0.1 + 0.2, 0.1), 0.3);
+        assert_eq!(quantise(7.4, 2.0), 8.0);
+    }
+
+    #[test]
+    fn every_value_is_checked_before_anything_runs() {
+        let set = ["simulation.duration=0.1".to_string()];
+        let ok = ["0".to_string(), "0.01".to_string()];
+        let base = load_checked(&paper(), &set, "network.delay", &ok).expect("valid");
+        assert_eq!(
+            default_out(&base, "agent[2].omega"),
+            PathBuf::from(format!("results/{}-sweep-agent_2__omega", base.name()))
+        );
+        let bad = ["0".to_string(), "-1".to_string()];
+        let e = load_checked(&paper(), &set, "network.delay", &bad).unwrap_err();
+        assert!(e.to_string().contains("network.delay"), "{e}");
+    }
+
+    #[test]
+    fn options_out_of_range_are_refused() {
+        assert_eq!(options().validate(), Ok(()));
+        let cases: [(&str, fn(&mut SweepOptions)); 7] = [
+            ("--jobs", |o| o.jobs = 0),
+            ("--tolerance", |o| o.tolerance = f64::NAN),
+            ("--tolerance", |o| o.tolerance = 0.0),
+            ("--bisect", |o| o.find_margin.as_mut().unwrap().iterations = 65),
+            ("--quantum", |o| o.find_margin.as_mut().unwrap().quantum = Some(0.0)),
+            ("--quantum", |o| o.find_margin.as_mut().unwrap().quantum = Some(f64::INFINITY)),
+            ("--stage-timeout", |o| o.run.processes.stage_timeout = -1.0),
+        ];
+        for (option, break_it) in cases {
+            let mut o = options();
+            break_it(&mut o);
+            let e = o.validate().unwrap_err();
+            assert!(e.to_string().starts_with(option), "{option}: {e}");
+        }
+    }
+
+    #[test]
+    fn an_interrupted_sweep_leaves_nothing() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let mut o = options();
+        o.run.out = tmp.path().join("sweep");
+        let interrupt = Interrupt::new();
+        interrupt.trigger(signal_hook::consts::SIGTERM);
+        let e = sweep(&o, &interrupt).unwrap_err();
+        assert!(matches!(e, SweepError::Interrupted(15)), "{e}");
+        assert_eq!(e.to_string(), "interrupted by SIGTERM");
+        assert_eq!(std::fs::read_dir(tmp.path()).expect("dir").count(), 0);
+    }
+}
