@@ -107,7 +107,10 @@ mod tests {
         assert_eq!(Error::from(RunEnd::Interrupted(15)).exit_code(), 143);
         assert_eq!(Error::from(RunEnd::Interrupted(1)).exit_code(), 129);
         assert_eq!(Error::from(SweepError::Interrupted(2)).exit_code(), 130);
-        assert_eq!(Error::from(RunEnd::Failed("node died".into())).exit_code(), 1);
+        assert_eq!(
+            Error::from(RunEnd::Failed("node died".into())).exit_code(),
+            1
+        );
         assert_eq!(Error::NotConforming.exit_code(), 1);
         assert_eq!(Error::Export("bad file".into()).exit_code(), 1);
         let run = SweepError::Run {

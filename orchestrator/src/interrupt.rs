@@ -114,7 +114,10 @@ mod tests {
         assert_eq!(exit_code(signal_hook::consts::SIGINT), 130);
         assert_eq!(exit_code(signal_hook::consts::SIGTERM), 143);
         assert_eq!(exit_code(signal_hook::consts::SIGHUP), 129);
-        assert_eq!(reason(signal_hook::consts::SIGTERM), "interrupted by SIGTERM");
+        assert_eq!(
+            reason(signal_hook::consts::SIGTERM),
+            "interrupted by SIGTERM"
+        );
         assert_eq!(reason(signal_hook::consts::SIGHUP), "interrupted by SIGHUP");
     }
 

@@ -156,11 +156,7 @@ pub fn node_index(
     match id {
         0 if leader => Ok(0),
         _ => net.index_of(id).map(|i| i + 1).ok_or_else(|| {
-            out_of_range(
-                option,
-                id,
-                format!("{}: no node {id}", scenario.display()),
-            )
+            out_of_range(option, id, format!("{}: no node {id}", scenario.display()))
         }),
     }
 }
@@ -171,7 +167,14 @@ mod tests {
 
     #[test]
     fn seconds_refuse_nan_inf_negative_zero_and_huge() {
-        for v in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300, MAX_SECONDS * 1.01] {
+        for v in [
+            f64::NAN,
+            f64::INFINITY,
+            -1.0,
+            0.0,
+            1e300,
+            MAX_SECONDS * 1.01,
+        ] {
             let e = seconds("--stage-timeout", v).unwrap_err();
             assert!(e.to_string().starts_with("--stage-timeout "), "{e}");
         }

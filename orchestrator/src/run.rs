@@ -163,16 +163,12 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
             let out = processes::run(net, &process_opts, &logs, interrupt.flag(), record)?;
             // The engine stopped for the interrupt: say which signal.
             let failure = out.failure.map(|f| match f.strip_suffix("interrupted") {
-                Some(blame) if interrupt.is_set() => blame.to_owned() + &interrupted_reason(interrupt),
+                Some(blame) if interrupt.is_set() => {
+                    blame.to_owned() + &interrupted_reason(interrupt)
+                }
                 _ => f,
             });
-            (
-                out.peak_torques,
-                out.steps,
-                failure,
-                out.links,
-                out.pacing,
-            )
+            (out.peak_torques, out.steps, failure, out.links, out.pacing)
         }
     };
     let wall_seconds = started.elapsed().as_secs_f64();
@@ -368,15 +364,20 @@ mod tests {
 
     #[test]
     fn an_interrupted_run_keeps_its_results_and_names_the_signal() {
-        let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/timevarying.toml");
-        let loaded = crate::scenario::load(&file, &["simulation.duration=0.1".into()]).expect("valid");
+        let file =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/timevarying.toml");
+        let loaded =
+            crate::scenario::load(&file, &["simulation.duration=0.1".into()]).expect("valid");
         let tmp = tempfile::tempdir().expect("tempdir");
         let interrupt = Interrupt::new();
         interrupt.trigger(signal_hook::consts::SIGHUP);
         let out = tmp.path().join("out");
         let s = run(&loaded, &options(out.clone()), &interrupt).expect("results");
         assert!(!s.complete);
-        assert_eq!(s.incomplete_reason.as_deref(), Some("interrupted by SIGHUP"));
+        assert_eq!(
+            s.incomplete_reason.as_deref(),
+            Some("interrupted by SIGHUP")
+        );
         assert_eq!(verdict(&s, &interrupt), Err(RunEnd::Interrupted(1)));
         assert!(out.join("summary.json").is_file() && out.join("errors.csv").is_file());
         let done = run(&loaded, &options(out), &Interrupt::new()).expect("results");

@@ -297,7 +297,14 @@ pub fn sweep(o: &SweepOptions, interrupt: &Interrupt) -> Result<SweepResult, Swe
             let quantum = b
                 .quantum
                 .or_else(|| default_quantum(&o.param, base.resolved.network.dt));
-            Some(bisect(o, &dir, &mut rows, b.iterations, quantum, interrupt)?)
+            Some(bisect(
+                o,
+                &dir,
+                &mut rows,
+                b.iterations,
+                quantum,
+                interrupt,
+            )?)
         }
         None => None,
     };
@@ -555,16 +562,25 @@ mod tests {
         assert!(e.to_string().contains("network.delay"), "{e}");
     }
 
+    /// Puts one option out of range.
+    type Breaker = fn(&mut SweepOptions);
+
     #[test]
     fn options_out_of_range_are_refused() {
         assert_eq!(options().validate(), Ok(()));
-        let cases: [(&str, fn(&mut SweepOptions)); 7] = [
+        let cases: [(&str, Breaker); 7] = [
             ("--jobs", |o| o.jobs = 0),
             ("--tolerance", |o| o.tolerance = f64::NAN),
             ("--tolerance", |o| o.tolerance = 0.0),
-            ("--bisect", |o| o.find_margin.as_mut().unwrap().iterations = 65),
-            ("--quantum", |o| o.find_margin.as_mut().unwrap().quantum = Some(0.0)),
-            ("--quantum", |o| o.find_margin.as_mut().unwrap().quantum = Some(f64::INFINITY)),
+            ("--bisect", |o| {
+                o.find_margin.as_mut().unwrap().iterations = 65
+            }),
+            ("--quantum", |o| {
+                o.find_margin.as_mut().unwrap().quantum = Some(0.0)
+            }),
+            ("--quantum", |o| {
+                o.find_margin.as_mut().unwrap().quantum = Some(f64::INFINITY)
+            }),
             ("--stage-timeout", |o| o.run.processes.stage_timeout = -1.0),
         ];
         for (option, break_it) in cases {

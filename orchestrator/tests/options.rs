@@ -37,10 +37,16 @@ fn refused(args: &[&str], option: &str) {
 
 fn run(engine: &str, extra: &[&str]) -> Vec<String> {
     let s = scenario();
-    let mut v: Vec<String> = ["run", s.to_str().expect("utf-8"), "--engine", engine, "--quiet"]
-        .iter()
-        .map(|s| (*s).to_string())
-        .collect();
+    let mut v: Vec<String> = [
+        "run",
+        s.to_str().expect("utf-8"),
+        "--engine",
+        engine,
+        "--quiet",
+    ]
+    .iter()
+    .map(|s| (*s).to_string())
+    .collect();
     v.extend(extra.iter().map(|s| (*s).to_string()));
     v
 }
@@ -71,11 +77,13 @@ fn strs(v: &[String]) -> Vec<&str> {
 #[test]
 fn stage_timeout_out_of_range_is_refused() {
     for t in ["nan", "inf", "-1", "0", "1e300", "86401"] {
+        // `--option=VALUE`: clap takes `-1` after a space for a flag.
+        let flag = format!("--stage-timeout={t}");
         for engine in ["processes", "in-process"] {
-            let args = run(engine, &["--stage-timeout", t]);
+            let args = run(engine, &[&flag]);
             refused(&strs(&args), "--stage-timeout");
         }
-        let args = sweep(&["--stage-timeout", t]);
+        let args = sweep(&[&flag]);
         refused(&strs(&args), "--stage-timeout");
     }
 }
@@ -83,7 +91,7 @@ fn stage_timeout_out_of_range_is_refused() {
 #[test]
 fn realtime_factor_out_of_range_is_refused() {
     for f in ["nan", "inf", "-1", "0", "1e300"] {
-        let args = run("processes", &["--realtime", f]);
+        let args = run("processes", &[&format!("--realtime={f}")]);
         refused(&strs(&args), "--realtime");
     }
 }
@@ -94,12 +102,12 @@ fn sweep_options_out_of_range_are_refused() {
         (&["--jobs", "0"], "--jobs"),
         (&["--tolerance", "0"], "--tolerance"),
         (&["--tolerance", "nan"], "--tolerance"),
-        (&["--tolerance", "-1e-3"], "--tolerance"),
+        (&["--tolerance=-1e-3"], "--tolerance"),
         (&["--find-margin", "--bisect", "1000"], "--bisect"),
         (&["--find-margin", "--quantum", "0"], "--quantum"),
         (&["--find-margin", "--quantum", "nan"], "--quantum"),
         (&["--find-margin", "--quantum", "inf"], "--quantum"),
-        (&["--find-margin", "--quantum", "-0.001"], "--quantum"),
+        (&["--find-margin", "--quantum=-0.001"], "--quantum"),
     ];
     for (extra, option) in cases {
         let args = sweep(extra);

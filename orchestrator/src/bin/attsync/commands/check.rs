@@ -27,7 +27,8 @@ pub fn exec(a: Check) -> Result<(), Error> {
     let net = &loaded.resolved.network;
     let index = attsync::options::node_index(net, id, "--node-config", true, &loaded.file)?;
     let root = Path::new("/tmp/attsync-iox2/RUN");
-    let cfg = processes::node_configs(net, "RUN", root, &ProcessOptions::default()).swap_remove(index);
+    let cfg =
+        processes::node_configs(net, "RUN", root, &ProcessOptions::default()).swap_remove(index);
     println!(
         "{}",
         serde_json::to_string_pretty(&cfg).expect("a config serialises")
