@@ -1,4 +1,4 @@
-//! [`Error`]: every way a command of `attsync` can fail, and the exit code
+//! [`enum@Error`]: every way a command of `attsync` can fail, and the exit code
 //! of each ([`Error::exit_code`]):
 //!
 //! | code | meaning |

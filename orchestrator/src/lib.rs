@@ -12,7 +12,7 @@
 //! - [`conform`]: the conformance check of a plug-in agent program.
 //! - [`options`]: range checks of command-line options, before anything starts.
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
-//! - [`error`]: [`Error`], every way a command fails, and its exit code.
+//! - [`error`]: [`enum@Error`], every way a command fails, and its exit code.
 //!
 //! The binary (`src/bin/attsync/`) only parses the command line and calls
 //! these; one file per subcommand in `commands/`.
