@@ -4,14 +4,28 @@
 //! - [`scenario`]: the TOML format, `--set` overrides, validation, resolution
 //!   into the model's [`attitude::network::Network`].
 //! - [`run`]: engines and the run driver (progress, interruption).
+//! - [`processes`]: the process-per-node engine (namespace, supervision,
+//!   telemetry).
 //! - [`results`]: `errors.csv`, `summary.json`, `errors.svg`, atomic output.
+//! - [`sweep`]: one field over many values, and the bisection for the margin.
 //! - [`generate`]: generated scenarios (random trees).
 //! - [`conform`]: the conformance check of a plug-in agent program.
+//! - [`options`]: range checks of command-line options, before anything starts.
+//! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
+//! - [`error`]: [`enum@Error`], every way a command fails, and its exit code.
+//!
+//! The binary (`src/bin/attsync/`) only parses the command line and calls
+//! these; one file per subcommand in `commands/`.
 
 pub mod conform;
+pub mod error;
 pub mod generate;
+pub mod interrupt;
+pub mod options;
 pub mod processes;
 pub mod results;
 pub mod run;
 pub mod scenario;
 pub mod sweep;
+
+pub use error::Error;

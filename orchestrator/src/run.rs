@@ -1,13 +1,14 @@
 //! `attsync run`: a loaded scenario through an engine into a results
 //! directory.
 
+use crate::interrupt::Interrupt;
+use crate::options::{self, OptionError};
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::results::{self, Recorder, Summary, plot, staging::Staging};
 use crate::scenario::Loaded;
 use attitude::engine::InProcess;
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 use thiserror::Error;
 
@@ -44,6 +45,28 @@ pub struct RunOptions {
     pub progress: bool,
 }
 
+impl RunOptions {
+    /// Checks the options that do not depend on the scenario
+    /// (`--stage-timeout`, `--realtime`; limits in [`crate::options`]).
+    ///
+    /// # Errors
+    /// The first option out of its range.
+    pub fn validate(&self) -> Result<(), OptionError> {
+        options::seconds("--stage-timeout", self.processes.stage_timeout)?;
+        options::seconds("--start-timeout", self.processes.start_timeout)?;
+        if let Some(f) = self.processes.realtime {
+            options::realtime(f)?;
+        }
+        Ok(())
+    }
+}
+
+/// The default results directory: `results/<scenario name>`.
+#[must_use]
+pub fn default_out(loaded: &Loaded) -> PathBuf {
+    PathBuf::from("results").join(loaded.name())
+}
+
 /// Why a run produced no results.
 #[derive(Debug, Error)]
 pub enum RunError {
@@ -58,9 +81,9 @@ pub enum RunError {
     /// The process engine could not start.
     #[error(transparent)]
     Processes(#[from] ProcessError),
-    /// The options do not fit the scenario.
-    #[error("{0}")]
-    Options(String),
+    /// The options are out of range or do not fit the scenario.
+    #[error(transparent)]
+    Options(#[from] OptionError),
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -79,14 +102,11 @@ fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 }
 
 /// Runs `loaded` and writes its results to `opts.out` (atomically). Stops
-/// early, keeping the results so far marked incomplete, when `interrupt`
-/// becomes true.
-pub fn run(
-    loaded: &Loaded,
-    opts: &RunOptions,
-    interrupt: &AtomicBool,
-) -> Result<Summary, RunError> {
+/// early, keeping the results so far marked incomplete (the reason names
+/// the signal, [`crate::interrupt::reason`]), when `interrupt` is raised.
+pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<Summary, RunError> {
     let net = &loaded.resolved.network;
+    opts.validate()?;
     check_options(loaded, opts)?;
     let mut process_opts = opts.processes.clone();
     process_opts.plugins = loaded.resolved.plugins.clone();
@@ -112,7 +132,7 @@ pub fn run(
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
             engine.run(|snap| {
-                if interrupt.load(Ordering::Relaxed) {
+                if interrupt.is_set() {
                     interrupted = true;
                     return false;
                 }
@@ -133,18 +153,26 @@ pub fn run(
             (
                 peaks,
                 engine.step_index(),
-                interrupted.then(|| "interrupted".to_string()),
+                interrupted.then(|| interrupted_reason(interrupt)),
                 links,
                 Vec::new(),
                 Vec::new(),
             )
         }
         Engine::Processes => {
-            let out = processes::run(net, &process_opts, &dir.join("logs"), interrupt, record)?;
+            let logs = dir.join("logs");
+            let out = processes::run(net, &process_opts, &logs, interrupt.flag(), record)?;
+            // The engine stopped for the interrupt: say which signal.
+            let failure = out.failure.map(|f| match f.strip_suffix("interrupted") {
+                Some(blame) if interrupt.is_set() => {
+                    blame.to_owned() + &interrupted_reason(interrupt)
+                }
+                _ => f,
+            });
             (
                 out.peak_torques,
                 out.steps,
-                out.failure,
+                failure,
                 out.links,
                 out.pacing,
                 out.nodes,
@@ -229,30 +257,55 @@ pub fn run(
     Ok(summary)
 }
 
+/// `incomplete_reason` of an interrupted run.
+fn interrupted_reason(interrupt: &Interrupt) -> String {
+    crate::interrupt::reason(interrupt.signal().unwrap_or(signal_hook::consts::SIGINT))
+}
+
+/// How a run that produced results ended, as an error if it did not
+/// complete: the signal that interrupted it, or why it failed.
+///
+/// # Errors
+/// [`RunEnd::Interrupted`] or [`RunEnd::Failed`].
+pub fn verdict(summary: &Summary, interrupt: &Interrupt) -> Result<(), RunEnd> {
+    match (&summary.incomplete_reason, interrupt.signal()) {
+        (None, _) => Ok(()),
+        (Some(_), Some(signal)) => Err(RunEnd::Interrupted(signal)),
+        (Some(reason), None) => Err(RunEnd::Failed(reason.clone())),
+    }
+}
+
+/// A run that wrote its results but did not complete.
+#[derive(Debug, Clone, PartialEq, Eq, Error)]
+pub enum RunEnd {
+    /// A signal stopped it (the number).
+    #[error("{}", crate::interrupt::reason(*.0))]
+    Interrupted(i32),
+    /// It failed: a node died, stalled or broke the protocol (the reason
+    /// in `summary.json`).
+    #[error("the run failed: {0}")]
+    Failed(String),
+}
+
 /// Options that the scenario cannot run with.
-fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), RunError> {
+fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), OptionError> {
     let plugins = &loaded.resolved.plugins;
     if opts.engine == Engine::InProcess {
         if let Some(p) = plugins.first() {
-            return Err(RunError::Options(format!(
+            return Err(OptionError::Conflict(format!(
                 "agent {} is a plug-in (`{}`): plug-ins need --engine processes",
                 p.agent,
                 p.display()
             )));
         }
         if opts.processes.realtime.is_some() {
-            return Err(RunError::Options(
+            return Err(OptionError::Conflict(
                 "--realtime needs --engine processes (the in-process engine is lockstep only)"
                     .into(),
             ));
         }
     }
-    if let Some(f) = opts.processes.realtime {
-        if !(f.is_finite() && f > 0.0) {
-            return Err(RunError::Options(format!(
-                "--realtime {f}: the factor must be a positive number (simulated s per wall s)"
-            )));
-        }
+    if opts.processes.realtime.is_some() {
         let net = &loaded.resolved.network;
         let impaired = net.agents.iter().any(|a| {
             a.model
@@ -263,7 +316,7 @@ fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), RunError> {
                 .any(|l| l.is_impaired())
         });
         if impaired {
-            return Err(RunError::Options(
+            return Err(OptionError::Conflict(
                 "--realtime cannot be combined with [network] impairments: they are defined in \
                  simulated lockstep time; in real-time mode the transport's own latency is measured"
                     .into(),
@@ -295,4 +348,57 @@ fn progress_bar(enabled: bool, steps: u64, dt: f64) -> ProgressBar {
         },
     );
     ProgressBar::new(steps).with_style(style)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn options(out: PathBuf) -> RunOptions {
+        RunOptions {
+            engine: Engine::InProcess,
+            out,
+            processes: ProcessOptions::default(),
+            progress: false,
+        }
+    }
+
+    #[test]
+    fn stage_timeout_and_realtime_are_checked() {
+        assert_eq!(options(PathBuf::new()).validate(), Ok(()));
+        for t in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300] {
+            let mut o = options(PathBuf::new());
+            o.processes.stage_timeout = t;
+            let e = o.validate().unwrap_err();
+            assert!(e.to_string().starts_with("--stage-timeout"), "{e}");
+        }
+        for f in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300] {
+            let mut o = options(PathBuf::new());
+            o.processes.realtime = Some(f);
+            let e = o.validate().unwrap_err();
+            assert!(e.to_string().starts_with("--realtime"), "{e}");
+        }
+    }
+
+    #[test]
+    fn an_interrupted_run_keeps_its_results_and_names_the_signal() {
+        let file =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/timevarying.toml");
+        let loaded =
+            crate::scenario::load(&file, &["simulation.duration=0.1".into()]).expect("valid");
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let interrupt = Interrupt::new();
+        interrupt.trigger(signal_hook::consts::SIGHUP);
+        let out = tmp.path().join("out");
+        let s = run(&loaded, &options(out.clone()), &interrupt).expect("results");
+        assert!(!s.complete);
+        assert_eq!(
+            s.incomplete_reason.as_deref(),
+            Some("interrupted by SIGHUP")
+        );
+        assert_eq!(verdict(&s, &interrupt), Err(RunEnd::Interrupted(1)));
+        assert!(out.join("summary.json").is_file() && out.join("errors.csv").is_file());
+        let done = run(&loaded, &options(out), &Interrupt::new()).expect("results");
+        assert_eq!(verdict(&done, &Interrupt::new()), Ok(()));
+    }
 }

@@ -4,15 +4,22 @@
 //!
 //! Convergence criterion: the run completes and every agent's attitude error
 //! `|Rᵢ R₀ᵀ|_I` at the end of the run is below `tolerance` (default 1e-3).
+//!
+//! Policy (all here, where tests reach it): every value must make a valid
+//! scenario before anything runs ([`load_checked`], exit code 2 like an
+//! invalid `--set`); bisection points are rounded to a quantum, by default
+//! the step `simulation.dt` for a timing field ([`default_quantum`]).
 
+use crate::interrupt::Interrupt;
+use crate::options::{self, OptionError};
 use crate::results::staging::Staging;
-use crate::run::{RunOptions, run};
-use crate::scenario;
+use crate::run::{RunError, RunOptions, run};
+use crate::scenario::{self, Loaded, ScenarioError};
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, Ordering};
+use thiserror::Error;
 
 /// What to sweep and how.
 #[derive(Debug, Clone)]
@@ -23,16 +30,149 @@ pub struct SweepOptions {
     pub param: String,
     /// Values (TOML literals).
     pub values: Vec<String>,
-    /// Parallel runs.
+    /// Parallel runs (≥ 1; [`default_jobs`]).
     pub jobs: usize,
     /// Other overrides applied to every run.
     pub set: Vec<String>,
     /// Engine and output options of each run (`out` is the sweep directory).
     pub run: RunOptions,
-    /// Convergence tolerance on the final attitude error.
+    /// Convergence tolerance on the final attitude error (> 0).
     pub tolerance: f64,
-    /// Bisect between the first and last value for the margin: iterations and quantum.
-    pub find_margin: Option<(u32, f64)>,
+    /// Bisect between the first value that does not converge and the one
+    /// before it, for the margin.
+    pub find_margin: Option<Bisection>,
+}
+
+/// How the margin is bisected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bisection {
+    /// Iterations (0..=[`options::MAX_BISECT`]).
+    pub iterations: u32,
+    /// Round bisection points to multiples of this (> 0); `None`:
+    /// [`default_quantum`].
+    pub quantum: Option<f64>,
+}
+
+impl SweepOptions {
+    /// Checks `--jobs`, `--tolerance`, `--bisect`, `--quantum` and the
+    /// options of every run ([`RunOptions::validate`]).
+    ///
+    /// # Errors
+    /// The first option out of its range.
+    pub fn validate(&self) -> Result<(), OptionError> {
+        options::count("--jobs", self.jobs as u64, 1, u64::MAX)?;
+        options::positive("--tolerance", self.tolerance)?;
+        if let Some(b) = self.find_margin {
+            options::count(
+                "--bisect",
+                u64::from(b.iterations),
+                0,
+                u64::from(options::MAX_BISECT),
+            )?;
+            if let Some(q) = b.quantum {
+                options::positive("--quantum", q)?;
+            }
+        }
+        self.run.validate()
+    }
+}
+
+/// Why a sweep produced no results.
+#[derive(Debug, Error)]
+pub enum SweepError {
+    /// The scenario, or the scenario with one of the values, is invalid.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// An option is out of range.
+    #[error(transparent)]
+    Options(#[from] OptionError),
+    /// One of the runs could not produce results.
+    #[error("{param} = {value}: {source}")]
+    Run {
+        /// The swept field.
+        param: String,
+        /// The value of the run.
+        value: String,
+        /// Why.
+        source: RunError,
+    },
+    /// `--find-margin` found no bracket to bisect, or a non-numeric one.
+    #[error("--find-margin needs {0}")]
+    Margin(String),
+    /// A signal stopped the sweep (the number); nothing is kept.
+    #[error("{}", crate::interrupt::reason(*.0))]
+    Interrupted(i32),
+    /// Writing the sweep's files failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// File or directory concerned.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Drawing `sweep.svg` failed.
+    #[error("sweep.svg: {0}")]
+    Plot(String),
+}
+
+fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
+    move |source| SweepError::Io {
+        path: path.to_owned(),
+        source,
+    }
+}
+
+/// The overrides of the run of `value`: `set`, then `param=value`.
+fn overrides(set: &[String], param: &str, value: &str) -> Vec<String> {
+    let mut with = set.to_vec();
+    with.push(format!("{param}={value}"));
+    with
+}
+
+/// Loads the scenario with `set`, and checks that every value of `param`
+/// makes a valid scenario too; returns the scenario without `param`.
+///
+/// # Errors
+/// The first invalid scenario.
+pub fn load_checked(
+    scenario: &Path,
+    set: &[String],
+    param: &str,
+    values: &[String],
+) -> Result<Loaded, ScenarioError> {
+    let loaded = scenario::load(scenario, set)?;
+    for v in values {
+        scenario::load(scenario, &overrides(set, param, v))?;
+    }
+    Ok(loaded)
+}
+
+/// The default sweep directory: `results/<scenario name>-sweep-<param>`
+/// (`.`, `[` and `]` of the field path as `_`).
+#[must_use]
+pub fn default_out(loaded: &Loaded, param: &str) -> PathBuf {
+    PathBuf::from("results").join(format!(
+        "{}-sweep-{}",
+        loaded.name(),
+        param.replace(['.', '[', ']'], "_")
+    ))
+}
+
+/// The default quantum of bisection points: the step `dt` for a timing
+/// field (one whose name ends in `delay`, `jitter` or `period`, which are
+/// only meaningful in whole steps), else none.
+#[must_use]
+pub fn default_quantum(param: &str, dt: f64) -> Option<f64> {
+    let timing = ["delay", "jitter", "period"]
+        .iter()
+        .any(|k| param.ends_with(k));
+    timing.then_some(dt)
+}
+
+/// The default number of runs at once: the number of cores (2 if unknown).
+#[must_use]
+pub fn default_jobs() -> usize {
+    std::thread::available_parallelism().map_or(2, std::num::NonZero::get)
 }
 
 /// One run of a sweep.
@@ -66,18 +206,20 @@ fn run_one(
     dir: &Path,
     k: usize,
     value: &str,
-    interrupt: &AtomicBool,
-) -> Result<SweepRow, String> {
-    let mut set = o.set.clone();
-    set.push(format!("{}={value}", o.param));
-    let loaded = scenario::load(&o.scenario, &set).map_err(|e| e.to_string())?;
+    interrupt: &Interrupt,
+) -> Result<SweepRow, SweepError> {
+    let loaded = scenario::load(&o.scenario, &overrides(&o.set, &o.param, value))?;
     let name = format!("{k:03}-{}", value.replace(['/', ' ', '"'], "_"));
     let opts = RunOptions {
         out: dir.join("runs").join(&name),
         progress: false,
         ..o.run.clone()
     };
-    let s = run(&loaded, &opts, interrupt).map_err(|e| format!("{} = {value}: {e}", o.param))?;
+    let s = run(&loaded, &opts, interrupt).map_err(|source| SweepError::Run {
+        param: o.param.clone(),
+        value: value.to_string(),
+        source,
+    })?;
     let time_to_1e3 = s
         .agents
         .iter()
@@ -93,16 +235,22 @@ fn run_one(
     })
 }
 
-/// Runs `values` with up to `jobs` at once.
+/// The error of an interrupted sweep.
+fn interrupted(interrupt: &Interrupt) -> SweepError {
+    SweepError::Interrupted(interrupt.signal().unwrap_or(signal_hook::consts::SIGINT))
+}
+
+/// Runs `values` with up to `jobs` at once. An interrupt stops the sweep.
 fn run_many(
     o: &SweepOptions,
     dir: &Path,
     first: usize,
     values: &[String],
-    interrupt: &AtomicBool,
-) -> Result<Vec<SweepRow>, String> {
+    interrupt: &Interrupt,
+) -> Result<Vec<SweepRow>, SweepError> {
     let next = Mutex::new(0usize);
-    let out: Mutex<Vec<Option<Result<SweepRow, String>>>> = Mutex::new(vec![None; values.len()]);
+    let out: Mutex<Vec<Option<Result<SweepRow, SweepError>>>> =
+        Mutex::new(values.iter().map(|_| None).collect());
     std::thread::scope(|s| {
         for _ in 0..o.jobs.max(1).min(values.len()) {
             s.spawn(|| {
@@ -113,7 +261,7 @@ fn run_many(
                         *n += 1;
                         k
                     };
-                    if k >= values.len() || interrupt.load(Ordering::Relaxed) {
+                    if k >= values.len() || interrupt.is_set() {
                         return;
                     }
                     let r = run_one(o, dir, first + k, &values[k], interrupt);
@@ -122,71 +270,120 @@ fn run_many(
             });
         }
     });
+    if interrupt.is_set() {
+        return Err(interrupted(interrupt));
+    }
     out.into_inner()
         .expect("lock")
         .into_iter()
-        .map(|r| r.unwrap_or_else(|| Err("interrupted".into())))
+        .map(|r| r.unwrap_or_else(|| Err(interrupted(interrupt))))
         .collect()
 }
 
 /// Runs the sweep and writes `sweep.csv`, `sweep.svg` and every run's
-/// results under `runs/` into `o.run.out` (atomically).
-pub fn sweep(o: &SweepOptions, interrupt: &AtomicBool) -> Result<SweepResult, String> {
-    // Validate every value before running anything.
-    for v in &o.values {
-        let mut set = o.set.clone();
-        set.push(format!("{}={v}", o.param));
-        scenario::load(&o.scenario, &set).map_err(|e| e.to_string())?;
-    }
-    let staging = Staging::new(&o.run.out).map_err(|e| format!("{}: {e}", o.run.out.display()))?;
+/// results under `runs/` into `o.run.out` (atomically). Nothing runs unless
+/// every option is valid and every value makes a valid scenario.
+///
+/// # Errors
+/// See [`SweepError`]; an interrupted sweep leaves nothing behind.
+pub fn sweep(o: &SweepOptions, interrupt: &Interrupt) -> Result<SweepResult, SweepError> {
+    o.validate()?;
+    let base = load_checked(&o.scenario, &o.set, &o.param, &o.values)?;
+    let staging = Staging::new(&o.run.out).map_err(io_at(&o.run.out))?;
     let dir = staging.path().to_owned();
     let mut rows = run_many(o, &dir, 0, &o.values, interrupt)?;
-    let mut margin = None;
-    if let Some((iterations, quantum)) = o.find_margin {
-        let parse = |v: &str| {
-            v.parse::<f64>()
-                .map_err(|_| format!("--find-margin needs numeric values, got {v:?}"))
-        };
-        // Bracket: the first value that does not converge and the one before it.
-        let Some(k) = rows.iter().position(|r| !r.converged) else {
-            return Err(format!(
-                "--find-margin needs a value that does not converge: every value of {} converges",
-                o.param
-            ));
-        };
-        if k == 0 {
-            return Err(format!(
-                "--find-margin needs the first value to converge: {} = {} does not",
-                o.param, rows[0].value
-            ));
+    let margin = match o.find_margin {
+        Some(b) => {
+            let quantum = b
+                .quantum
+                .or_else(|| default_quantum(&o.param, base.resolved.network.dt));
+            Some(bisect(
+                o,
+                &dir,
+                &mut rows,
+                b.iterations,
+                quantum,
+                interrupt,
+            )?)
         }
-        let (mut lo, mut hi) = (parse(&rows[k - 1].value)?, parse(&rows[k].value)?);
-        for _ in 0..iterations {
-            let mut mid = 0.5 * (lo + hi);
-            if quantum > 0.0 {
-                // A multiple of the quantum, written without round-off noise.
-                let decimals = (-quantum.log10()).ceil().max(0.0) as usize + 1;
-                mid = format!("{:.decimals$}", (mid / quantum).round() * quantum)
-                    .parse()
-                    .expect("a formatted number parses");
-                if mid <= lo.min(hi) + quantum * 0.5 || mid >= lo.max(hi) - quantum * 0.5 {
-                    break;
-                }
-            }
-            let value = format!("{mid}");
-            let row =
-                run_many(o, &dir, rows.len(), std::slice::from_ref(&value), interrupt)?.remove(0);
-            if row.converged {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-            rows.push(row);
-        }
-        margin = Some((lo, hi));
+        None => None,
+    };
+    write_files(o, &dir, &rows, margin)?;
+    staging.commit().map_err(io_at(&o.run.out))?;
+    Ok(SweepResult { rows, margin })
+}
+
+/// The bracket: the first value that does not converge and the one before it.
+fn bracket(o: &SweepOptions, rows: &[SweepRow]) -> Result<(f64, f64), SweepError> {
+    let parse = |v: &str| {
+        v.parse::<f64>()
+            .map_err(|_| SweepError::Margin(format!("numeric values, got {v:?}")))
+    };
+    let Some(k) = rows.iter().position(|r| !r.converged) else {
+        return Err(SweepError::Margin(format!(
+            "a value that does not converge: every value of {} converges",
+            o.param
+        )));
+    };
+    if k == 0 {
+        return Err(SweepError::Margin(format!(
+            "the first value to converge: {} = {} does not",
+            o.param, rows[0].value
+        )));
     }
+    Ok((parse(&rows[k - 1].value)?, parse(&rows[k].value)?))
+}
+
+/// `mid` rounded to a multiple of `quantum`, written without round-off
+/// noise (`0.1 + 0.2` is `0.3`).
+#[must_use]
+pub fn quantise(mid: f64, quantum: f64) -> f64 {
+    let decimals = (-quantum.log10()).ceil().max(0.0) as usize + 1;
+    format!("{:.decimals$}", (mid / quantum).round() * quantum)
+        .parse()
+        .expect("a formatted number parses")
+}
+
+/// Bisects the bracket for `iterations` (fewer once the points, rounded to
+/// `quantum`, meet): the largest converging value and the smallest failing.
+fn bisect(
+    o: &SweepOptions,
+    dir: &Path,
+    rows: &mut Vec<SweepRow>,
+    iterations: u32,
+    quantum: Option<f64>,
+    interrupt: &Interrupt,
+) -> Result<(f64, f64), SweepError> {
+    let (mut lo, mut hi) = bracket(o, rows)?;
+    for _ in 0..iterations {
+        let mut mid = 0.5 * (lo + hi);
+        if let Some(q) = quantum.filter(|&q| q > 0.0) {
+            mid = quantise(mid, q);
+            if mid <= lo.min(hi) + q * 0.5 || mid >= lo.max(hi) - q * 0.5 {
+                break;
+            }
+        }
+        let value = format!("{mid}");
+        let row = run_many(o, dir, rows.len(), std::slice::from_ref(&value), interrupt)?.remove(0);
+        if row.converged {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        rows.push(row);
+    }
+    Ok((lo, hi))
+}
+
+/// `sweep.csv`, `sweep.json`, `sweep.svg` and the staging marker.
+fn write_files(
+    o: &SweepOptions,
+    dir: &Path,
+    rows: &[SweepRow],
+    margin: Option<(f64, f64)>,
+) -> Result<(), SweepError> {
     let mut csv = String::from("value,final_max_att_err,time_to_1e-3,converged,complete,run\n");
-    for r in &rows {
+    for r in rows {
         let _ = writeln!(
             csv,
             "{},{},{},{},{},{}",
@@ -198,25 +395,19 @@ pub fn sweep(o: &SweepOptions, interrupt: &AtomicBool) -> Result<SweepResult, St
             r.dir
         );
     }
-    std::fs::write(dir.join("sweep.csv"), csv).map_err(|e| e.to_string())?;
+    let file = dir.join("sweep.csv");
+    std::fs::write(&file, csv).map_err(io_at(&file))?;
     let info = serde_json::json!({
         "param": o.param,
         "criterion": format!("complete and every agent's final att_err < {}", o.tolerance),
         "margin": margin.map(|(lo, hi)| serde_json::json!({"largest_converging": lo, "smallest_failing": hi})),
     });
-    std::fs::write(
-        dir.join("sweep.json"),
-        serde_json::to_string_pretty(&info).expect("json") + "\n",
-    )
-    .map_err(|e| e.to_string())?;
-    plot(&dir.join("sweep.svg"), &o.param, &rows).map_err(|e| format!("sweep.svg: {e}"))?;
-    std::fs::write(
-        dir.join(crate::results::staging::MARKER),
-        serde_json::to_string_pretty(&info).expect("json") + "\n",
-    )
-    .map_err(|e| e.to_string())?;
-    staging.commit().map_err(|e| e.to_string())?;
-    Ok(SweepResult { rows, margin })
+    let info = serde_json::to_string_pretty(&info).expect("json") + "\n";
+    let file = dir.join("sweep.json");
+    std::fs::write(&file, &info).map_err(io_at(&file))?;
+    plot(&dir.join("sweep.svg"), &o.param, rows).map_err(SweepError::Plot)?;
+    let file = dir.join(crate::results::staging::MARKER);
+    std::fs::write(&file, &info).map_err(io_at(&file))
 }
 
 /// The table printed at the end.
@@ -308,4 +499,108 @@ fn plot(file: &Path, param: &str, rows: &[SweepRow]) -> Result<(), String> {
         }))
         .map_err(|e| e.to_string())?;
     root.present().map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::processes::ProcessOptions;
+    use crate::run::Engine;
+
+    fn paper() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/constant-observerless.toml")
+    }
+
+    fn options() -> SweepOptions {
+        SweepOptions {
+            scenario: paper(),
+            param: "network.delay".into(),
+            values: vec!["0".into(), "0.1".into()],
+            jobs: 2,
+            set: Vec::new(),
+            run: RunOptions {
+                engine: Engine::InProcess,
+                out: PathBuf::from("unused"),
+                processes: ProcessOptions::default(),
+                progress: false,
+            },
+            tolerance: 1e-3,
+            find_margin: Some(Bisection {
+                iterations: 8,
+                quantum: None,
+            }),
+        }
+    }
+
+    #[test]
+    fn timing_fields_default_to_the_step_as_quantum() {
+        assert_eq!(default_quantum("network.delay", 1e-3), Some(1e-3));
+        assert_eq!(default_quantum("network.jitter", 1e-3), Some(1e-3));
+        assert_eq!(default_quantum("edge[0].period", 2e-3), Some(2e-3));
+        assert_eq!(default_quantum("network.loss", 1e-3), None);
+        assert_eq!(default_quantum("scheme.control.k_r", 1e-3), None);
+    }
+
+    #[test]
+    fn bisection_points_are_clean_multiples_of_the_quantum() {
+        assert_eq!(quantise(0.123_456, 1e-3), 0.123);
+        assert_eq!(quantise(0.1 + 0.2, 0.1), 0.3);
+        assert_eq!(quantise(7.4, 2.0), 8.0);
+    }
+
+    #[test]
+    fn every_value_is_checked_before_anything_runs() {
+        let set = ["simulation.duration=0.1".to_string()];
+        let ok = ["0".to_string(), "0.01".to_string()];
+        let base = load_checked(&paper(), &set, "network.delay", &ok).expect("valid");
+        assert_eq!(
+            default_out(&base, "agent[2].omega"),
+            PathBuf::from(format!("results/{}-sweep-agent_2__omega", base.name()))
+        );
+        let bad = ["0".to_string(), "-1".to_string()];
+        let e = load_checked(&paper(), &set, "network.delay", &bad).unwrap_err();
+        assert!(e.to_string().contains("network.delay"), "{e}");
+    }
+
+    /// Puts one option out of range.
+    type Breaker = fn(&mut SweepOptions);
+
+    #[test]
+    fn options_out_of_range_are_refused() {
+        assert_eq!(options().validate(), Ok(()));
+        let cases: [(&str, Breaker); 7] = [
+            ("--jobs", |o| o.jobs = 0),
+            ("--tolerance", |o| o.tolerance = f64::NAN),
+            ("--tolerance", |o| o.tolerance = 0.0),
+            ("--bisect", |o| {
+                o.find_margin.as_mut().unwrap().iterations = 65
+            }),
+            ("--quantum", |o| {
+                o.find_margin.as_mut().unwrap().quantum = Some(0.0)
+            }),
+            ("--quantum", |o| {
+                o.find_margin.as_mut().unwrap().quantum = Some(f64::INFINITY)
+            }),
+            ("--stage-timeout", |o| o.run.processes.stage_timeout = -1.0),
+        ];
+        for (option, break_it) in cases {
+            let mut o = options();
+            break_it(&mut o);
+            let e = o.validate().unwrap_err();
+            assert!(e.to_string().starts_with(option), "{option}: {e}");
+        }
+    }
+
+    #[test]
+    fn an_interrupted_sweep_leaves_nothing() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let mut o = options();
+        o.run.out = tmp.path().join("sweep");
+        let interrupt = Interrupt::new();
+        interrupt.trigger(signal_hook::consts::SIGTERM);
+        let e = sweep(&o, &interrupt).unwrap_err();
+        assert!(matches!(e, SweepError::Interrupted(15)), "{e}");
+        assert_eq!(e.to_string(), "interrupted by SIGTERM");
+        assert_eq!(std::fs::read_dir(tmp.path()).expect("dir").count(), 0);
+    }
 }

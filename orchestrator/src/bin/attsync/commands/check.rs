@@ -1,0 +1,37 @@
+//! `attsync check`: validate a scenario and print its network, or the
+//! configuration one node would receive.
+
+use super::ScenarioArgs;
+use attsync::Error;
+use attsync::processes::{self, ProcessOptions};
+use std::path::Path;
+
+/// `attsync check SCENARIO [--set K=V]… [--node-config ID]`.
+#[derive(Debug, clap::Args)]
+pub struct Check {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+    /// Print instead the JSON configuration node ID (0 = leader) would
+    /// receive (PROTOCOL.md; `run` and `iox_root` are placeholders).
+    #[arg(long, value_name = "ID")]
+    pub node_config: Option<u32>,
+}
+
+/// Prints the network, or node `--node-config`'s configuration.
+pub fn exec(a: Check) -> Result<(), Error> {
+    let loaded = a.scenario.load()?;
+    let Some(id) = a.node_config else {
+        print!("{}", attsync::scenario::report::describe(&loaded));
+        return Ok(());
+    };
+    let net = &loaded.resolved.network;
+    let index = attsync::options::node_index(net, id, "--node-config", true, &loaded.file)?;
+    let root = Path::new("/tmp/attsync-iox2/RUN");
+    let cfg =
+        processes::node_configs(net, "RUN", root, &ProcessOptions::default()).swap_remove(index);
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&cfg).expect("a config serialises")
+    );
+    Ok(())
+}

@@ -1,0 +1,60 @@
+//! `attsync conform`: a plug-in agent program against PROTOCOL.md.
+
+use super::SetArgs;
+use attsync::Error;
+use attsync::conform::{self, ConformOptions};
+use std::path::PathBuf;
+
+/// `attsync conform [--scenario F] [--agent ID] [--set K=V]… -- COMMAND…`.
+#[derive(Debug, clap::Args)]
+pub struct Conform {
+    /// Neighbourhood scenario [default: built-in: agent 2 between agents 1
+    /// and 3, hearing the leader, observerless scheme, 0.2 s].
+    #[arg(long)]
+    pub scenario: Option<PathBuf>,
+    /// The candidate's agent id in the neighbourhood.
+    #[arg(long, default_value_t = 2)]
+    pub agent: u32,
+    #[command(flatten)]
+    pub overrides: SetArgs,
+    /// Longest wait for one of the candidate's states, s.
+    #[arg(long, default_value_t = 5.0)]
+    pub stage_timeout: f64,
+    /// Longest wait for the candidate to connect, s.
+    #[arg(long, default_value_t = 20.0)]
+    pub start_timeout: f64,
+    /// Where the candidate's output goes [default: a file in the temp directory].
+    #[arg(long)]
+    pub log: Option<PathBuf>,
+    /// The candidate program and its arguments (after `--`).
+    #[arg(last = true, required = true, value_name = "COMMAND")]
+    pub command: Vec<String>,
+}
+
+/// Checks the candidate and prints one verdict per rule; fails unless every
+/// rule passes.
+pub fn exec(a: Conform) -> Result<(), Error> {
+    let log = a.log.unwrap_or_else(|| {
+        std::env::temp_dir().join(format!("attsync-conform-{}.log", std::process::id()))
+    });
+    let opts = ConformOptions {
+        command: a.command,
+        scenario: a.scenario,
+        set: a.overrides.set,
+        agent: a.agent,
+        stage_timeout: a.stage_timeout,
+        start_timeout: a.start_timeout,
+        log,
+    };
+    attsync::options::conform(&opts)?;
+    let loaded = conform::neighbourhood(&opts)?;
+    let net = &loaded.resolved.network;
+    attsync::options::node_index(net, opts.agent, "--agent", false, &loaded.file)?;
+    let report = conform::conform(&opts).map_err(|e| Error::Conform(e.into()))?;
+    println!("{}", report.table());
+    if report.passed() {
+        Ok(())
+    } else {
+        Err(Error::NotConforming)
+    }
+}

@@ -1,0 +1,143 @@
+//! The subcommands, one file each (`cli` struct + `exec`), and the flags
+//! they share, declared once and `#[command(flatten)]`ed.
+
+mod check;
+mod conform;
+mod export;
+mod r#gen;
+mod run;
+mod sweep;
+
+use attsync::Error;
+use attsync::interrupt::Interrupt;
+use attsync::processes::ProcessOptions;
+use attsync::run::Engine;
+use attsync::scenario::{self, Loaded};
+use clap::{Subcommand, ValueEnum};
+use msgs::config::WaitStrategy;
+use std::path::{Path, PathBuf};
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Validate a scenario and print its network.
+    Check(check::Check),
+    /// Run a scenario and write its results.
+    Run(run::Run),
+    /// Run a scenario for each value of one field (in parallel), and optionally
+    /// bisect for the largest value that still converges.
+    Sweep(sweep::Sweep),
+    /// Check a plug-in agent program against PROTOCOL.md: attsync plays its
+    /// orchestrator, leader and neighbours in lockstep and reports each rule.
+    /// Exit code 0 only if every rule passes.
+    Conform(conform::Conform),
+    /// Convert a run's states.bin (the full state trajectory).
+    Export(export::Export),
+    /// Generate a scenario.
+    Gen(r#gen::GenCmd),
+}
+
+/// Runs `command`.
+pub fn exec(command: Command) -> Result<(), Error> {
+    match command {
+        Command::Check(a) => check::exec(a),
+        Command::Run(a) => run::exec(a, &interrupt()?),
+        Command::Sweep(a) => sweep::exec(a, &interrupt()?),
+        Command::Conform(a) => conform::exec(a),
+        Command::Export(a) => export::exec(a),
+        Command::Gen(a) => r#gen::exec(a),
+    }
+}
+
+/// The one handler of SIGINT, SIGTERM and SIGHUP (commands that run
+/// scenarios install it; the others keep the default actions).
+fn interrupt() -> Result<Interrupt, Error> {
+    Interrupt::install().map_err(Error::Signals)
+}
+
+/// `--set`, shared by every command that loads a scenario.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SetArgs {
+    /// Override a field of the scenario (of every run of a sweep, of conform's
+    /// neighbourhood): key.path=value (repeatable), e.g. simulation.duration=10.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+/// A scenario file and its `--set` overrides.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ScenarioArgs {
+    /// Scenario file (TOML).
+    pub scenario: PathBuf,
+    #[command(flatten)]
+    pub overrides: SetArgs,
+}
+
+impl ScenarioArgs {
+    /// The scenario with its overrides, validated.
+    pub fn load(&self) -> Result<Loaded, Error> {
+        Ok(scenario::load(&self.scenario, &self.overrides.set)?)
+    }
+}
+
+/// The engine of a run and the process engine's flags.
+#[derive(Debug, Clone, clap::Args)]
+pub struct EngineArgs {
+    /// Engine.
+    #[arg(long, value_enum, default_value_t = Engine::Processes)]
+    pub engine: Engine,
+    /// How node processes wait for their inputs (processes engine).
+    #[arg(long, value_enum, default_value_t = WaitArg::Adaptive)]
+    pub wait: WaitArg,
+    /// Longest wait of a node for one stage's inputs, s (processes engine).
+    #[arg(long, default_value_t = 10.0)]
+    pub stage_timeout: f64,
+}
+
+impl EngineArgs {
+    /// The process engine's options (`realtime`: the factor, if any).
+    pub fn process_options(&self, realtime: Option<f64>) -> ProcessOptions {
+        ProcessOptions {
+            wait: self.wait.into(),
+            stage_timeout: self.stage_timeout,
+            realtime,
+            ..ProcessOptions::default()
+        }
+    }
+}
+
+/// `--wait`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum WaitArg {
+    /// Busy-poll.
+    Spin,
+    /// Poll with sched_yield.
+    Yield,
+    /// Sleep on iceoryx2 events (1 ms slices).
+    Block,
+    /// Yield a while, then block.
+    Adaptive,
+}
+
+impl From<WaitArg> for WaitStrategy {
+    fn from(w: WaitArg) -> Self {
+        match w {
+            WaitArg::Spin => WaitStrategy::Spin,
+            WaitArg::Yield => WaitStrategy::Yield,
+            WaitArg::Block => WaitStrategy::Block,
+            WaitArg::Adaptive => WaitStrategy::Adaptive,
+        }
+    }
+}
+
+/// Writes `bytes` to `out`, or to stdout.
+fn write_output(out: Option<&Path>, bytes: &[u8]) -> Result<(), Error> {
+    let written = match out {
+        Some(path) => std::fs::write(path, bytes),
+        None => std::io::Write::write_all(&mut std::io::stdout(), bytes),
+    };
+    written.map_err(|source| Error::Write {
+        path: out.map_or_else(|| "<stdout>".into(), Path::to_owned),
+        source,
+    })
+}

@@ -1,0 +1,53 @@
+//! `attsync run`: a scenario through an engine into a results directory.
+
+use super::{EngineArgs, ScenarioArgs};
+use attsync::Error;
+use attsync::interrupt::Interrupt;
+use attsync::run::{self, RunOptions};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+/// `attsync run SCENARIO [--engine E] [--wait W] [--stage-timeout S]
+/// [--realtime [FACTOR]] [--out DIR] [--set K=V]… [--quiet]`.
+#[derive(Debug, clap::Args)]
+pub struct Run {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+    #[command(flatten)]
+    pub engine: EngineArgs,
+    /// Real-time mode: nodes run free against the wall clock at FACTOR
+    /// simulated seconds per wall second [default FACTOR: 1], never wait for
+    /// their inputs, and the links' measured age of information is reported.
+    /// Not deterministic. Without it: deterministic lockstep.
+    #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]
+    pub realtime: Option<f64>,
+    /// Results directory [default: results/<scenario name>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Runs the scenario, prints its summary; an incomplete run is an error
+/// (its results are kept).
+pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
+    let mut opts = RunOptions {
+        engine: a.engine.engine,
+        out: a.out.clone().unwrap_or_default(),
+        processes: a.engine.process_options(a.realtime),
+        progress: !a.quiet && std::io::stderr().is_terminal(),
+    };
+    opts.validate()?;
+    let loaded = a.scenario.load()?;
+    for w in &loaded.resolved.warnings {
+        eprintln!("warning: {}: {w}", loaded.file.display());
+    }
+    if a.out.is_none() {
+        opts.out = run::default_out(&loaded);
+    }
+    let summary = run::run(&loaded, &opts, interrupt)?;
+    println!("{}", summary.table());
+    println!("results: {}", opts.out.display());
+    Ok(run::verdict(&summary, interrupt)?)
+}

@@ -1,0 +1,73 @@
+//! `attsync sweep`: one field of a scenario over many values, in parallel,
+//! and optionally the bisection for the margin.
+
+use super::{EngineArgs, ScenarioArgs};
+use attsync::Error;
+use attsync::interrupt::Interrupt;
+use attsync::run::RunOptions;
+use attsync::sweep::{self, Bisection, SweepOptions};
+use std::path::PathBuf;
+
+/// `attsync sweep SCENARIO --param FIELD --values V1,V2,… […]`.
+#[derive(Debug, clap::Args)]
+pub struct Sweep {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+    /// Field to sweep, as for --set (e.g. network.delay, network.loss, scheme.control.k_r).
+    #[arg(long)]
+    pub param: String,
+    /// Values, comma-separated (TOML literals).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub values: Vec<String>,
+    /// Runs at once [default: number of cores].
+    #[arg(long)]
+    pub jobs: Option<usize>,
+    #[command(flatten)]
+    pub engine: EngineArgs,
+    /// Sweep directory [default: results/<scenario name>-sweep-<param>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Converged: complete, and every agent's final attitude error below this.
+    #[arg(long, default_value_t = 1e-3)]
+    pub tolerance: f64,
+    /// Bisect between the first value that does not converge and the one before it (the first must converge).
+    #[arg(long)]
+    pub find_margin: bool,
+    /// Bisection iterations.
+    #[arg(long, default_value_t = 8)]
+    pub bisect: u32,
+    /// Round bisection points to multiples of this [default: simulation.dt for delays, jitters and periods, else none].
+    #[arg(long)]
+    pub quantum: Option<f64>,
+}
+
+/// Runs the sweep and prints its table.
+pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
+    let mut o = SweepOptions {
+        scenario: a.scenario.scenario.clone(),
+        param: a.param,
+        values: a.values,
+        jobs: a.jobs.unwrap_or_else(sweep::default_jobs),
+        set: a.scenario.overrides.set.clone(),
+        run: RunOptions {
+            engine: a.engine.engine,
+            out: a.out.clone().unwrap_or_default(),
+            processes: a.engine.process_options(None),
+            progress: false,
+        },
+        tolerance: a.tolerance,
+        find_margin: a.find_margin.then_some(Bisection {
+            iterations: a.bisect,
+            quantum: a.quantum,
+        }),
+    };
+    o.validate()?;
+    let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values)?;
+    if a.out.is_none() {
+        o.run.out = sweep::default_out(&base, &o.param);
+    }
+    let r = sweep::sweep(&o, interrupt)?;
+    print!("{}", sweep::table(&o.param, &r));
+    println!("results: {}", o.run.out.display());
+    Ok(())
+}

@@ -1,0 +1,43 @@
+//! `attsync`: run networks of rigid bodies synchronising their attitudes.
+//!
+//! The binary only parses the command line and calls the library, one file
+//! per subcommand in `commands/`; the exit code comes from the error
+//! ([`attsync::Error::exit_code`]): 0 success, 2 invalid scenario, `--set`
+//! or option, 1 any other error, 128 + N interrupted by signal N.
+
+mod commands;
+
+use clap::Parser;
+use std::process::ExitCode;
+
+/// Leader-follower attitude synchronisation on SO(3), one process per rigid body.
+#[derive(Debug, Parser)]
+#[command(name = "attsync", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: commands::Command,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match commands::exec(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if e.is_scenario() {
+                eprintln!("{e}");
+            } else {
+                eprintln!("error: {e}");
+            }
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_command_line_is_well_formed() {
+        use clap::CommandFactory;
+        super::Cli::command().debug_assert();
+    }
+}

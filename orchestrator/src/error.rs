@@ -1,0 +1,126 @@
+//! [`enum@Error`]: every way a command of `attsync` can fail, and the exit code
+//! of each ([`Error::exit_code`]):
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | success |
+//! | 2 | invalid scenario, `--set` or option (nothing was started) |
+//! | 1 | any other error (a node died, a rule failed, a file could not be written…) |
+//! | 128 + N | interrupted by signal N: 130 SIGINT, 143 SIGTERM, 129 SIGHUP |
+
+use crate::options::OptionError;
+use crate::run::{RunEnd, RunError};
+use crate::scenario::ScenarioError;
+use crate::sweep::SweepError;
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Why a command failed.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// The scenario, or a `--set`, is invalid.
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// An option is out of range or does not fit the scenario.
+    #[error(transparent)]
+    Options(#[from] OptionError),
+    /// A run could not produce results.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A run wrote its results but did not complete.
+    #[error(transparent)]
+    RunEnd(#[from] RunEnd),
+    /// A sweep produced no results.
+    #[error(transparent)]
+    Sweep(#[from] SweepError),
+    /// The conformance harness could not run.
+    #[error("{0}")]
+    Conform(Box<dyn std::error::Error + Send + Sync>),
+    /// The candidate program failed at least one rule of PROTOCOL.md.
+    #[error("the candidate does not conform to PROTOCOL.md (see the table)")]
+    NotConforming,
+    /// A states.bin file could not be exported.
+    #[error("{0}")]
+    Export(String),
+    /// A scenario could not be generated.
+    #[error("{0}")]
+    Generate(String),
+    /// Writing an output file failed.
+    #[error("writing {path}: {source}")]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The signal handler could not be installed.
+    #[error("installing the signal handler: {0}")]
+    Signals(std::io::Error),
+}
+
+impl Error {
+    /// The process exit code for this error (see the module's table).
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::Scenario(_) | Error::Options(_) => 2,
+            Error::Run(e) => run_code(e),
+            Error::RunEnd(RunEnd::Interrupted(signal)) => crate::interrupt::exit_code(*signal),
+            Error::Sweep(e) => match e {
+                SweepError::Scenario(_) | SweepError::Options(_) => 2,
+                SweepError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
+                SweepError::Run { source, .. } => run_code(source),
+                _ => 1,
+            },
+            _ => 1,
+        }
+    }
+
+    /// Whether the message is printed as it is (a scenario error's lines
+    /// already read `FILE: FIELD: REASON`), not after `error: `.
+    #[must_use]
+    pub fn is_scenario(&self) -> bool {
+        matches!(
+            self,
+            Error::Scenario(_) | Error::Sweep(SweepError::Scenario(_))
+        )
+    }
+}
+
+fn run_code(e: &RunError) -> u8 {
+    match e {
+        RunError::Options(_) => 2,
+        _ => 1,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exit_codes() {
+        let opt = || OptionError::Conflict("x".into());
+        assert_eq!(Error::from(opt()).exit_code(), 2);
+        assert_eq!(Error::from(RunError::Options(opt())).exit_code(), 2);
+        assert_eq!(Error::from(SweepError::Options(opt())).exit_code(), 2);
+        assert_eq!(Error::from(RunEnd::Interrupted(15)).exit_code(), 143);
+        assert_eq!(Error::from(RunEnd::Interrupted(1)).exit_code(), 129);
+        assert_eq!(Error::from(SweepError::Interrupted(2)).exit_code(), 130);
+        assert_eq!(
+            Error::from(RunEnd::Failed("node died".into())).exit_code(),
+            1
+        );
+        assert_eq!(Error::NotConforming.exit_code(), 1);
+        assert_eq!(Error::Export("bad file".into()).exit_code(), 1);
+        let run = SweepError::Run {
+            param: "network.delay".into(),
+            value: "1".into(),
+            source: RunError::Plot {
+                path: "x.svg".into(),
+                message: "m".into(),
+            },
+        };
+        assert_eq!(Error::from(run).exit_code(), 1);
+    }
+}

@@ -1,0 +1,207 @@
+//! Checks of command-line options, made before anything starts: a refused
+//! option is an [`OptionError`] (exit code 2) that names it, and nothing is
+//! written or spawned.
+//!
+//! Limits (all inclusive):
+//! - durations (`--stage-timeout`, `--start-timeout`, `gen tree
+//!   --duration`): finite, > 0 and at most [`MAX_SECONDS`] (1 day);
+//! - `--realtime` factor: finite, > 0 and at most [`MAX_REALTIME`];
+//! - `--tolerance`, `--quantum`: finite and > 0;
+//! - `--jobs`: ≥ 1; `--bisect`: 1..=[`MAX_BISECT`].
+
+use crate::conform::ConformOptions;
+use crate::generate::TreeParams;
+use attitude::network::Network;
+use thiserror::Error;
+
+/// Longest duration an option may give, s (one day: a wait past it is a
+/// mistake, and `Duration::from_secs_f64` would overflow not far above).
+pub const MAX_SECONDS: f64 = 86_400.0;
+
+/// Largest real-time factor (simulated s per wall s): past it, a step of
+/// any sensible `dt` is due in less than a nanosecond.
+pub const MAX_REALTIME: f64 = 1e6;
+
+/// Most bisection iterations (each halves the bracket: 64 reach f64's
+/// resolution of any bracket).
+pub const MAX_BISECT: u32 = 64;
+
+/// An option that cannot be used.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum OptionError {
+    /// A value outside the option's range.
+    #[error("{option} {value}: {expected}")]
+    OutOfRange {
+        /// The option, as written on the command line (`--stage-timeout`).
+        option: &'static str,
+        /// The value given.
+        value: String,
+        /// What the option takes.
+        expected: String,
+    },
+    /// Options that do not fit together or with the scenario.
+    #[error("{0}")]
+    Conflict(String),
+}
+
+fn out_of_range(option: &'static str, value: impl ToString, expected: String) -> OptionError {
+    OptionError::OutOfRange {
+        option,
+        value: value.to_string(),
+        expected,
+    }
+}
+
+/// A duration in seconds: finite, > 0, at most [`MAX_SECONDS`].
+///
+/// # Errors
+/// The value is outside that range.
+pub fn seconds(option: &'static str, value: f64) -> Result<(), OptionError> {
+    if value.is_finite() && value > 0.0 && value <= MAX_SECONDS {
+        return Ok(());
+    }
+    Err(out_of_range(
+        option,
+        value,
+        format!("must be a number of seconds > 0 and at most {MAX_SECONDS} (1 day)"),
+    ))
+}
+
+/// A real-time factor: finite, > 0, at most [`MAX_REALTIME`].
+///
+/// # Errors
+/// The value is outside that range.
+pub fn realtime(value: f64) -> Result<(), OptionError> {
+    if value.is_finite() && value > 0.0 && value <= MAX_REALTIME {
+        return Ok(());
+    }
+    Err(out_of_range(
+        "--realtime",
+        value,
+        format!(
+            "the factor must be a positive number (simulated s per wall s) of at most {MAX_REALTIME}"
+        ),
+    ))
+}
+
+/// A positive finite number.
+///
+/// # Errors
+/// The value is not finite or not > 0.
+pub fn positive(option: &'static str, value: f64) -> Result<(), OptionError> {
+    if value.is_finite() && value > 0.0 {
+        return Ok(());
+    }
+    Err(out_of_range(
+        option,
+        value,
+        "must be a finite number > 0".into(),
+    ))
+}
+
+/// A count in `min..=max`.
+///
+/// # Errors
+/// The value is outside that range.
+pub fn count(option: &'static str, value: u64, min: u64, max: u64) -> Result<(), OptionError> {
+    if (min..=max).contains(&value) {
+        return Ok(());
+    }
+    let expected = if max == u64::MAX {
+        format!("must be at least {min}")
+    } else {
+        format!("must be in {min}..={max}")
+    };
+    Err(out_of_range(option, value, expected))
+}
+
+/// `gen tree`'s `--agents` (≥ 1), `--leader-links` (1..=agents) and
+/// `--duration` (finite, > 0).
+///
+/// # Errors
+/// The first option out of its range.
+pub fn tree(p: &TreeParams) -> Result<(), OptionError> {
+    count("--agents", u64::from(p.agents), 1, u64::MAX)?;
+    count(
+        "--leader-links",
+        u64::from(p.leader_links),
+        1,
+        u64::from(p.agents),
+    )?;
+    positive("--duration", p.duration)
+}
+
+/// `conform`'s `--stage-timeout` and `--start-timeout` (durations).
+///
+/// # Errors
+/// The first option out of its range.
+pub fn conform(o: &ConformOptions) -> Result<(), OptionError> {
+    seconds("--stage-timeout", o.stage_timeout)?;
+    seconds("--start-timeout", o.start_timeout)
+}
+
+/// The index of node `id` (`option`'s value) in the list leader, agents…
+/// of `net` (`scenario` names it in the message); the leader (0) only if
+/// `leader` is allowed.
+///
+/// # Errors
+/// `net` has no such node.
+pub fn node_index(
+    net: &Network,
+    id: u32,
+    option: &'static str,
+    leader: bool,
+    scenario: &std::path::Path,
+) -> Result<usize, OptionError> {
+    match id {
+        0 if leader => Ok(0),
+        _ => net.index_of(id).map(|i| i + 1).ok_or_else(|| {
+            out_of_range(option, id, format!("{}: no node {id}", scenario.display()))
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seconds_refuse_nan_inf_negative_zero_and_huge() {
+        for v in [
+            f64::NAN,
+            f64::INFINITY,
+            -1.0,
+            0.0,
+            1e300,
+            MAX_SECONDS * 1.01,
+        ] {
+            let e = seconds("--stage-timeout", v).unwrap_err();
+            assert!(e.to_string().starts_with("--stage-timeout "), "{e}");
+        }
+        for v in [1e-3, 10.0, MAX_SECONDS] {
+            assert_eq!(seconds("--stage-timeout", v), Ok(()));
+        }
+    }
+
+    #[test]
+    fn realtime_factor_is_positive_and_bounded() {
+        for v in [f64::NAN, f64::INFINITY, -2.0, 0.0, 1e300] {
+            let e = realtime(v).unwrap_err();
+            assert!(e.to_string().contains("positive"), "{e}");
+        }
+        assert_eq!(realtime(1.0), Ok(()));
+        assert_eq!(realtime(MAX_REALTIME), Ok(()));
+    }
+
+    #[test]
+    fn positive_and_count() {
+        assert!(positive("--tolerance", 0.0).is_err());
+        assert!(positive("--quantum", f64::NAN).is_err());
+        assert!(positive("--quantum", -1e-3).is_err());
+        assert_eq!(positive("--tolerance", 1e-3), Ok(()));
+        let e = count("--jobs", 0, 1, u64::MAX).unwrap_err();
+        assert_eq!(e.to_string(), "--jobs 0: must be at least 1");
+        assert_eq!(count("--bisect", 64, 1, 64), Ok(()));
+        assert!(count("--bisect", 65, 1, 64).is_err());
+    }
+}
