@@ -180,20 +180,23 @@ def neg(a):
 
 
 def madd(a, b):
-    return tuple(x + y for x, y in zip(a, b))
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4],
+            a[5] + b[5], a[6] + b[6], a[7] + b[7], a[8] + b[8])
 
 
 def msub(a, b):
-    return tuple(x - y for x, y in zip(a, b))
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3], a[4] - b[4],
+            a[5] - b[5], a[6] - b[6], a[7] - b[7], a[8] - b[8])
 
 
 def mneg(a):
-    return tuple(-x for x in a)
+    return (-a[0], -a[1], -a[2], -a[3], -a[4], -a[5], -a[6], -a[7], -a[8])
 
 
 def mscale(a, k):
     """M·k, per entry."""
-    return tuple(x * k for x in a)
+    return (a[0] * k, a[1] * k, a[2] * k, a[3] * k, a[4] * k, a[5] * k, a[6] * k,
+            a[7] * k, a[8] * k)
 
 
 def tr(a):
@@ -243,6 +246,18 @@ def psi(m):
     return (0.5 * (m[7] - m[5]), 0.5 * (m[2] - m[6]), 0.5 * (m[3] - m[1]))
 
 
+def psi_mm(a, b):
+    """psi(A·B), computing only the off-diagonal entries of A·B that psi
+    reads (each exactly as `mm` computes it)."""
+    m01 = a[0] * b[1] + a[1] * b[4] + a[2] * b[7]
+    m02 = a[0] * b[2] + a[1] * b[5] + a[2] * b[8]
+    m10 = a[3] * b[0] + a[4] * b[3] + a[5] * b[6]
+    m12 = a[3] * b[2] + a[4] * b[5] + a[5] * b[8]
+    m20 = a[6] * b[0] + a[7] * b[3] + a[8] * b[6]
+    m21 = a[6] * b[1] + a[7] * b[4] + a[8] * b[7]
+    return (0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01))
+
+
 # ==========================================================================
 # § 10.2 exp and dexp^-1 on SO(3)
 # ==========================================================================
@@ -258,7 +273,13 @@ def exp_so3(u):
         a = math.sin(t) / t
         b = (1.0 - math.cos(t)) / t2
     k = hat(u)
-    return madd(madd(IDENTITY, mscale(k, a)), mscale(mm(k, k), b))
+    kk = mm(k, k)
+    # (I + K·a) + (K·K)·b, entry by entry
+    return (1.0 + k[0] * a + kk[0] * b, 0.0 + k[1] * a + kk[1] * b,
+            0.0 + k[2] * a + kk[2] * b, 0.0 + k[3] * a + kk[3] * b,
+            1.0 + k[4] * a + kk[4] * b, 0.0 + k[5] * a + kk[5] * b,
+            0.0 + k[6] * a + kk[6] * b, 0.0 + k[7] * a + kk[7] * b,
+            1.0 + k[8] * a + kk[8] * b)
 
 
 def dexp_inv(u, w):
@@ -338,10 +359,10 @@ def omega_hat_dot_7b(g, own, gains, nbrs, leader):
     d = s_i
     if leader is not None:
         a0, (r0, w0, _) = leader
-        d = sub(d, scale(mv(tr(r0), psi(mm(mm(a0, r_i), tr(r0)))), g["k_r"]))
+        d = sub(d, scale(mv(tr(r0), psi_mm(mm(a0, r_i), tr(r0))), g["k_r"]))
         d = sub(d, scale(sub(w_i, w0), g["k_w"]))
     for a, (r_j, w_j, _) in zip(gains, nbrs):
-        d = sub(d, scale(mv(tr(r_j), psi(mm(mm(a, r_i), tr(r_j)))), g["k_r"]))
+        d = sub(d, scale(mv(tr(r_j), psi_mm(mm(a, r_i), tr(r_j))), g["k_r"]))
         d = sub(d, scale(sub(w_i, w_j), g["k_w"]))
     return d
 
@@ -363,11 +384,11 @@ def omega_hat_dot_16b(g, own, gains, nbrs, leader):
     r_i, w_i, _ = own
     d = ZERO
     for a, (r_j, w_j, _) in zip(gains, nbrs):
-        d = sub(d, scale(psi(mm(mm(a, tr(r_j)), r_i)), g["k_r"]))
+        d = sub(d, scale(psi_mm(mm(a, tr(r_j)), r_i), g["k_r"]))
         d = sub(d, scale(sub(w_i, w_j), g["k_w"]))
     if leader is not None:
         a0, (r0, _, _) = leader
-        d = sub(d, scale(psi(mm(mm(a0, tr(r0)), r_i)), g["k_r"]))
+        d = sub(d, scale(psi_mm(mm(a0, tr(r0)), r_i), g["k_r"]))
         d = sub(d, scale(w_i, g["k_w"]))
     return d
 
@@ -396,7 +417,7 @@ def gamma_i(j, r_bar, v, w_hat_dot):
 
 def pd(g, a_bar, r_bar, w_bar):
     """k_R psi(A_bar R_bar) + k_w w_bar, shared by both observer-based laws."""
-    return add(scale(psi(mm(a_bar, r_bar)), g["k_r"]), scale(w_bar, g["k_w"]))
+    return add(scale(psi_mm(a_bar, r_bar), g["k_r"]), scale(w_bar, g["k_w"]))
 
 
 def tau_control(g, j, a_bar, error, w_hat_dot):
@@ -417,9 +438,9 @@ def tau_districontrol(g, r, w, gains, nbrs, leader):
     tau = scale(neg(w), g["k_w"])
     if leader is not None:
         a0, (r0, _, _) = leader
-        tau = sub(tau, scale(psi(mm(mm(a0, tr(r0)), r)), g["k_r"]))
+        tau = sub(tau, scale(psi_mm(mm(a0, tr(r0)), r), g["k_r"]))
     for a, (r_j, _, _) in zip(gains, nbrs):
-        tau = sub(tau, scale(psi(mm(mm(a, tr(r_j)), r)), g["k_r"]))
+        tau = sub(tau, scale(psi_mm(mm(a, tr(r_j)), r), g["k_r"]))
     return tau
 
 
