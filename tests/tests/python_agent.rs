@@ -98,44 +98,31 @@ fn the_paper_experiment_converges_with_a_python_agent() {
     }
 }
 
-/// `attsync conform` with the candidate in an observer scheme: the built-in
-/// neighbourhood switched to `kind` (with the paper's observer gains).
-fn conforms_in(kind: &str, extra: &[&str]) {
+/// `attsync conform` with the candidate (agent 2) in the neighbourhood
+/// `scenarios/plugin/<neighbourhood>.toml`.
+fn conforms_in(neighbourhood: &str) {
     require_iceoryx2_module();
-    let tmp = Sandbox::new(&format!("python-conform-{kind}"));
-    let mut sets = vec![format!("scheme.kind={kind}")];
-    sets.extend(extra.iter().map(|s| (*s).to_string()));
-    let mut r = Attsync::new(tmp.path())
-        .args(["conform", "--log"])
-        .args([tmp.join("candidate.log")]);
-    for s in &sets {
-        r = r.args(["--set", s]);
-    }
-    let r = r.args(["--", "python3"]).args([agent_py()]).output();
+    let tmp = Sandbox::new(neighbourhood);
+    let r = Attsync::new(tmp.path())
+        .args(["conform", "--scenario"])
+        .args([scenario(&format!("plugin/{neighbourhood}.toml"))])
+        .args(["--log"])
+        .args([tmp.join("candidate.log")])
+        .args(["--", "python3"])
+        .args([agent_py()])
+        .output();
     r.assert_ok();
     assert!(r.stdout.contains("9/9 rules pass"), "{}", r.describe());
 }
 
 #[test]
-fn the_python_agent_conforms_with_an_observer() {
-    conforms_in(
-        "observer-time-varying",
-        &[
-            "scheme.observer={ k_r = 9.0, k_omega = 14.0, k_sigma = 12.0 }",
-            "scheme.control={ k_r = 8.0, k_omega = 13.0 }",
-            "leader.reference=time-varying",
-            "leader.omega=[1.0, 2.0, 0.0]",
-            "leader.sigma=[1.0, 0.0, 0.0]",
-            "leader.p=[[-1.0, 0.0, 0.0], [0.0, 0.0, -0.7071067811865475], [0.0, 0.7071067811865476, 0.0]]",
-        ],
-    );
-    conforms_in(
-        "observer-constant",
-        &[
-            "scheme.observer={ k_r = 14.0, k_omega = 12.0 }",
-            "scheme.control={ k_r = 13.0, k_omega = 11.0 }",
-        ],
-    );
+fn the_python_agent_conforms_with_the_time_varying_observer() {
+    conforms_in("conform-timevarying");
+}
+
+#[test]
+fn the_python_agent_conforms_with_the_constant_observer() {
+    conforms_in("conform-constant-observer");
 }
 
 /// Runs `scenarios/plugin/<plugin>.toml` (agent 3 the Python agent) and
@@ -187,7 +174,11 @@ fn bit_identical_to_builtin(plugin: &str, builtin: &str, sets: &[&str]) {
 
 #[test]
 fn a_python_agent_with_the_time_varying_observer_is_bit_identical() {
-    bit_identical_to_builtin("python-timevarying", "timevarying", &["simulation.duration=5"]);
+    bit_identical_to_builtin(
+        "python-timevarying",
+        "timevarying",
+        &["simulation.duration=5"],
+    );
 }
 
 #[test]
