@@ -1059,7 +1059,8 @@ def realtime(ports, cfg, agent, refusals, orphan, start_unix_ns):
                 time.sleep(-lateness)
             else:
                 max_lateness = max(max_lateness, lateness)
-                late_stages += lateness > step_wall
+                if lateness > step_wall:  # more than one step late
+                    late_stages += 1
             if exchanges_at(cfg["coupling"], n, s):
                 exchanges += 1
                 first = n == 0 and s == 0
@@ -1121,9 +1122,10 @@ def step_all(ports, cfg, agent, orphan):
             pacing, meters, exchanges = realtime(ports, cfg, agent, refusals, orphan,
                                                  start_ns or started_ns)
             measured = (meters, exchanges)
-    except NodeError as e:
-        # Tell the orchestrator whom we waited for (best effort).
-        reason, sender = e.failed or (FAIL_OTHER, 0)
+    except Exception as e:
+        # Tell the orchestrator whom we waited for, or that it was something
+        # else (best effort: we are failing anyway).
+        reason, sender = getattr(e, "failed", None) or (FAIL_OTHER, 0)
         try:
             ports.report(telemetry(node_id, FAILED, FAILED_BODY, reason, sender))
         except Exception:
