@@ -368,7 +368,8 @@ def omega_hat_dot_7b(g, own, gains, nbrs, leader):
 
 
 def sigma_hat_dot_7c(g, p, own, nbrs, leader):
-    """(7c) ds_hat_i/dt = P s_hat_i - k_sigma sum_j (s_hat_i - s_hat_j) - k_sigma (s_hat_i - s_0)."""
+    """(7c) ds_hat_i/dt = P s_hat_i - k_sigma sum_j (s_hat_i - s_hat_j)
+    - k_sigma (s_hat_i - s_0)."""
     s_i = own[2]
     e = mv(p, s_i)
     for (_, _, s_j) in nbrs:
@@ -475,7 +476,8 @@ class Agent:
         self.held = [(IDENTITY, ZERO, ZERO)] * (len(self.gains) + (self.leader_gain is not None))
         self.peak_torque = 0.0
         r, w = matrix(initial["r"]), vec3(initial["w"])
-        r_hat, w_hat, s_hat = matrix(initial["r_hat"]), vec3(initial["w_hat"]), vec3(initial["s_hat"])
+        r_hat = matrix(initial["r_hat"])
+        w_hat, s_hat = vec3(initial["w_hat"]), vec3(initial["s_hat"])
         if self.observer:
             self.rk = Rkmk4([r, r_hat], [w, w_hat, s_hat], dt)
         else:
