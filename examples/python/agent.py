@@ -1,81 +1,106 @@
 #!/usr/bin/env python3
-"""An attsync agent written in Python: a plug-in that replaces one built-in
-`attsync-agent` process.
+"""An attsync agent in pure Python: a plug-in that takes the place of one
+built-in `attsync-agent` process (PROTOCOL.md, protocol version 3).
 
-It runs scheme 3 of the paper, the observerless law `districontrol`
+How to run it
+-------------
+    python3 -m pip install -r examples/python/requirements.txt   # iceoryx2==0.10.0
+    cargo build --release --workspace
+    ./target/release/attsync run scenarios/plugin/python-observerless.toml
+    ./target/release/attsync run scenarios/plugin/python-timevarying.toml
+    ./target/release/attsync run scenarios/plugin/python-observerless.toml --realtime
+    ./target/release/attsync conform -- python3 examples/python/agent.py
 
-    tau_i = -k_R psi(A_i0 R_0^T R_i) - k_R sum_j psi(A_ij R_j^T R_i) - k_w w_i
+In a scenario, `command = ["python3", "../../examples/python/agent.py"]` in an
+`[[agent]]` makes that agent this program. The orchestrator starts it as
+`<command...> --config FILE` (the file also in env ATTSYNC_CONFIG), in the
+scenario's directory, with stdout and stderr going to logs/agent-<id>.log.
 
-on the rigid body J_i dw_i/dt = -w_i x J_i w_i + tau_i, dR_i/dt = R_i hat(w_i),
-integrated with RKMK4 stage by stage exactly as attitude/src/integrate.rs does
-(same operations in the same order, pure Python floats: IEEE binary64, no
-fused multiply-add), so its trajectory matches the built-in agent's bit for
-bit.
+What it computes
+----------------
+All three schemes of the paper, bit-identical to the built-in agent:
+  1. observer-time-varying: observer eqs. 7a-7c, control law `control`;
+  2. observer-constant:     observer eqs. 16a-16b, law `controlconstantestimate`;
+  3. observerless:          law `districontrol`;
+on the rigid body J_i dw_i/dt = -w_i x J_i w_i + tau_i, dR_i/dt = R_i hat(w_i)
+(eq. `followeri`), integrated with RKMK4 stage by stage. Every function
+below is one equation or one building block of PROTOCOL.md § 10 ("The
+arithmetic, to the bit"), with the same floating-point operations in the
+same order: plain Python floats are IEEE binary64 with no fused
+multiply-add, and math.sin/cos are glibc's, as in the Rust agent.
 
-It speaks attsync's node protocol (version 2) over iceoryx2 shared memory
-(PyPI `iceoryx2==0.10.0`): started as `<command...> --config FILE` (also in
-env ATTSYNC_CONFIG), it reads the node's JSON configuration, opens every
-service with the limits of msgs/src/open.rs in the run's iceoryx2 namespace
-(prefix `as<run>_`, root path `iox_root`), waits until every edge is
-connected, reports Ready, waits for Start, steps in deterministic lockstep,
-reports telemetry samples, then Done, and waits for Stop.
-
-Supported: lockstep only (`realtime` = null), coupling "continuous" and
-"sampled", unimpaired links, the observerless scheme. Anything else is
-refused at start-up with exit code 2. Protocol violations, timeouts and the
-loss of the parent process exit with code 1; a clean run exits 0.
+How it runs
+-----------
+Lockstep (the default, § 6) or real time (`attsync run --realtime`, § 7),
+coupling "continuous" or "sampled", unimpaired links. Anything else
+(impaired links, the leader's role, a malformed configuration, another
+protocol version) is refused at start-up with exit code 2. Protocol
+violations, timeouts and the loss of the parent process exit with code 1;
+a clean run exits 0, after releasing every iceoryx2 resource it made.
 """
 
 import ctypes
+import gc
 import json
 import math
 import os
-import resource
 import struct
 import sys
 import time
 
-PROTOCOL_VERSION = 2
-ROTATION_TOLERANCE = 1e-6  # largest ||R^T R - I||_F accepted from a peer
-STOP_TIMEOUT = 600.0  # s, longest wait for Stop after Done
+PROTOCOL_VERSION = 3
+ROTATION_TOLERANCE = 1e-6  # largest ||R^T R - I||_F accepted from a peer (§ 8)
+STOP_TIMEOUT = 600.0  # s, longest wait for Stop after Done (§ 6.9)
 # sched_yield()s before sleeping on the wake event (wait = "adaptive");
 # env ATTSYNC_PY_YIELDS overrides it.
 ADAPTIVE_YIELDS = int(os.environ.get("ATTSYNC_PY_YIELDS", "20"))
 BLOCK_SLICE_MS = 1  # longest single sleep on the wake event
 
-# Telemetry kinds and control commands (msgs/src/payload.rs).
-READY, SAMPLE, DONE, LINK_STATS, FAILED = 1, 2, 3, 4, 5
-START, STOP = 1, 2
-
+SCHEMES = ("observer-time-varying", "observer-constant", "observerless")
 PROG = "attsync python agent"
 
 
 class NodeError(Exception):
-    """Ends the node with a message on stderr and exit code `code`."""
+    """Ends the node with a message on stderr and exit code `code`.
+    `failed` is the telemetry Failed (reason, input id) to report first,
+    when the node gives up while stepping (§ 5)."""
 
-    def __init__(self, msg, code=1):
+    def __init__(self, msg, code=1, failed=None):
         super().__init__(msg)
         self.code = code
+        self.failed = failed
 
 
 def log(msg):
-    """One line on stderr (the orchestrator writes it to logs/<node>.log)."""
+    """One line on stderr (the orchestrator writes it to logs/agent-<id>.log)."""
     sys.stderr.write(f"{time.strftime('%H:%M:%S')} {PROG}: {msg}\n")
     sys.stderr.flush()
 
 
-# --------------------------------------------------------------------------
-# Wire contract: msgs/src/payload.rs. Little-endian, #[repr(C)], no padding.
-# --------------------------------------------------------------------------
+# ==========================================================================
+# Payloads (PROTOCOL.md § 5): little-endian, #[repr(C)], no padding.
+# ==========================================================================
 
 # StateMsg, 152 bytes: version u32, sender u32, step u64, stage u32,
-# reserved u32, sent_unix_ns u64, r [f64; 9] (row-major), w [f64; 3], s [f64; 3].
+# reserved u32, sent_unix_ns u64, r f64[9] (row-major), w f64[3], s f64[3].
 STATE = struct.Struct("<IIQIIQ15d")
-# TelemetryMsg, 248 bytes: version u32, sender u32, step u64, kind u32,
-# reserved u32, r [9], w [3], r_hat [9], w_hat [3], s_hat [3], peak_torque f64.
-TELEMETRY = struct.Struct("<IIQII28d")
 # ControlMsg, 16 bytes: version u32, command u32, start_unix_ns u64.
 CONTROL = struct.Struct("<IIQ")
+START, STOP = 1, 2
+
+# TelemetryMsg, 248 bytes: a 16-byte header (version, sender, kind,
+# reserved: u32) and a 232-byte body laid out per kind; unused bytes are 0.
+TELEMETRY_SIZE = 248
+TELEMETRY_HEADER = struct.Struct("<IIII")
+READY, SAMPLE, DONE, LINK_STATS, FAILED = 1, 2, 3, 4, 5
+# Bodies, all starting at offset 16:
+SAMPLE_BODY = struct.Struct("<Q9d3d9d3d3dd")  # step, r, w, r_hat, w_hat, s_hat, peak_torque
+DONE_BODY = struct.Struct("<QdQQQQd")  # steps, peak_torque, peak_rss_kb, started_unix_ns,
+#                                        done_unix_ns, late_stages, max_lateness
+LINK_STATS_BODY = struct.Struct("<I4xQQQQQdd")  # from, sent, delivered, lost, rejected,
+#                                                 evaluations, age_sum, age_max
+FAILED_BODY = struct.Struct("<II")  # reason, from
+FAIL_TIMEOUT, FAIL_BAD_INPUT, FAIL_OTHER = 1, 2, 3
 
 
 def _c_struct(name, type_name, fields):
@@ -86,31 +111,101 @@ def _c_struct(name, type_name, fields):
     return cls
 
 
-U32, U64, F64 = ctypes.c_uint32, ctypes.c_uint64, ctypes.c_double
+U8, U32, U64, F64 = ctypes.c_uint8, ctypes.c_uint32, ctypes.c_uint64, ctypes.c_double
 StateMsg = _c_struct("StateMsg", "attsync::StateMsg", [
     ("version", U32), ("sender", U32), ("step", U64), ("stage", U32),
     ("reserved", U32), ("sent_unix_ns", U64), ("r", F64 * 9), ("w", F64 * 3),
     ("s", F64 * 3)])
 TelemetryMsg = _c_struct("TelemetryMsg", "attsync::TelemetryMsg", [
-    ("version", U32), ("sender", U32), ("step", U64), ("kind", U32),
-    ("reserved", U32), ("r", F64 * 9), ("w", F64 * 3), ("r_hat", F64 * 9),
-    ("w_hat", F64 * 3), ("s_hat", F64 * 3), ("peak_torque", F64)])
+    ("version", U32), ("sender", U32), ("kind", U32), ("reserved", U32),
+    ("body", U8 * 232)])
 ControlMsg = _c_struct("ControlMsg", "attsync::ControlMsg", [
     ("version", U32), ("command", U32), ("start_unix_ns", U64)])
-for _cls, _size in ((StateMsg, STATE.size), (TelemetryMsg, TELEMETRY.size),
-                    (ControlMsg, CONTROL.size)):
-    assert ctypes.sizeof(_cls) == _size == {StateMsg: 152, TelemetryMsg: 248,
-                                            ControlMsg: 16}[_cls]
-    assert ctypes.alignment(_cls) == 8
+assert (ctypes.sizeof(StateMsg), ctypes.alignment(StateMsg)) == (STATE.size, 8) == (152, 8)
+assert (ctypes.sizeof(TelemetryMsg), ctypes.alignment(TelemetryMsg)) == (TELEMETRY_SIZE, 4)
+assert (ctypes.sizeof(ControlMsg), ctypes.alignment(ControlMsg)) == (CONTROL.size, 8) == (16, 8)
+assert 16 + SAMPLE_BODY.size == TELEMETRY_SIZE
 
 
-# --------------------------------------------------------------------------
-# SO(3) and RKMK4, operation for operation as attitude/src/{so3,integrate}.rs
-# with nalgebra's evaluation order: a matrix product entry is
-# (a_i0 b_0j + a_i1 b_1j) + a_i2 b_2j. Matrices are row-major 9-tuples.
-# --------------------------------------------------------------------------
+def telemetry(node_id, kind, body=None, *fields):
+    """A TelemetryMsg's bytes: the header, then `fields` packed with `body`."""
+    buf = bytearray(TELEMETRY_SIZE)
+    TELEMETRY_HEADER.pack_into(buf, 0, PROTOCOL_VERSION, node_id, kind, 0)
+    if body is not None:
+        body.pack_into(buf, 16, *fields)
+    return bytes(buf)
+
+
+def unix_ns():
+    """Wall-clock time, ns since the Unix epoch."""
+    return time.time_ns()
+
+
+def peak_rss_kb():
+    """Peak resident set size of this process (VmHWM), kB; 0 if unknown."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1])
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
+# ==========================================================================
+# § 10.1 Building blocks. Vectors are 3-tuples, matrices row-major 9-tuples
+# (M[row][col] = m[3*row + col]); each operation is nalgebra's, in its order.
+# ==========================================================================
+
+ZERO = (0.0, 0.0, 0.0)
+IDENTITY = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+
+
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def scale(a, k):
+    """a·k."""
+    return (a[0] * k, a[1] * k, a[2] * k)
+
+
+def neg(a):
+    return (-a[0], -a[1], -a[2])
+
+
+def madd(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4],
+            a[5] + b[5], a[6] + b[6], a[7] + b[7], a[8] + b[8])
+
+
+def msub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3], a[4] - b[4],
+            a[5] - b[5], a[6] - b[6], a[7] - b[7], a[8] - b[8])
+
+
+def mneg(a):
+    return (-a[0], -a[1], -a[2], -a[3], -a[4], -a[5], -a[6], -a[7], -a[8])
+
+
+def mscale(a, k):
+    """M·k, per entry."""
+    return (a[0] * k, a[1] * k, a[2] * k, a[3] * k, a[4] * k, a[5] * k, a[6] * k,
+            a[7] * k, a[8] * k)
+
+
+def tr(a):
+    """The transpose."""
+    return (a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8])
+
 
 def mm(a, b):
+    """A·B: entry (i, j) = (a_i0 b_0j + a_i1 b_1j) + a_i2 b_2j."""
     a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
     b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
     return (a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7,
@@ -121,49 +216,55 @@ def mm(a, b):
             a6 * b2 + a7 * b5 + a8 * b8)
 
 
-def mm_transposed(a, b):
-    """a * b^T."""
-    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
-    b0, b3, b6, b1, b4, b7, b2, b5, b8 = b
-    return (a0 * b0 + a1 * b3 + a2 * b6, a0 * b1 + a1 * b4 + a2 * b7,
-            a0 * b2 + a1 * b5 + a2 * b8,
-            a3 * b0 + a4 * b3 + a5 * b6, a3 * b1 + a4 * b4 + a5 * b7,
-            a3 * b2 + a4 * b5 + a5 * b8,
-            a6 * b0 + a7 * b3 + a8 * b6, a6 * b1 + a7 * b4 + a8 * b7,
-            a6 * b2 + a7 * b5 + a8 * b8)
-
-
-def psi_of_product(a, b):
-    """psi(a * b) = 1/2 [m32 - m23, m13 - m31, m21 - m12], computing only the
-    off-diagonal entries of m = a b (each entry as in the full product)."""
-    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
-    b0, b1, b2, b3, b4, b5, b6, b7, b8 = b
-    m01 = a0 * b1 + a1 * b4 + a2 * b7
-    m02 = a0 * b2 + a1 * b5 + a2 * b8
-    m10 = a3 * b0 + a4 * b3 + a5 * b6
-    m12 = a3 * b2 + a4 * b5 + a5 * b8
-    m20 = a6 * b0 + a7 * b3 + a8 * b6
-    m21 = a6 * b1 + a7 * b4 + a8 * b7
-    return (0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01))
-
-
-def mv(a, v):
-    a0, a1, a2, a3, a4, a5, a6, a7, a8 = a
-    v0, v1, v2 = v
-    return (a0 * v0 + a1 * v1 + a2 * v2, a3 * v0 + a4 * v1 + a5 * v2,
-            a6 * v0 + a7 * v1 + a8 * v2)
+def mv(a, x):
+    """A·x."""
+    x0, x1, x2 = x
+    return (a[0] * x0 + a[1] * x1 + a[2] * x2, a[3] * x0 + a[4] * x1 + a[5] * x2,
+            a[6] * x0 + a[7] * x1 + a[8] * x2)
 
 
 def cross(a, b):
-    ax, ay, az = a
-    bx, by, bz = b
-    return (ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx)
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0])
 
+
+def norm2(a):
+    return a[0] * a[0] + a[1] * a[1] + a[2] * a[2]
+
+
+def norm(a):
+    return math.sqrt(norm2(a))
+
+
+def hat(a):
+    """The skew-symmetric matrix a^x (a^x b = a x b)."""
+    return (0.0, -a[2], a[1], a[2], 0.0, -a[0], -a[1], a[0], 0.0)
+
+
+def psi(m):
+    """psi = vex o Pa: the vector of the skew-symmetric part of M."""
+    return (0.5 * (m[7] - m[5]), 0.5 * (m[2] - m[6]), 0.5 * (m[3] - m[1]))
+
+
+def psi_mm(a, b):
+    """psi(A·B), computing only the off-diagonal entries of A·B that psi
+    reads (each exactly as `mm` computes it)."""
+    m01 = a[0] * b[1] + a[1] * b[4] + a[2] * b[7]
+    m02 = a[0] * b[2] + a[1] * b[5] + a[2] * b[8]
+    m10 = a[3] * b[0] + a[4] * b[3] + a[5] * b[6]
+    m12 = a[3] * b[2] + a[4] * b[5] + a[5] * b[8]
+    m20 = a[6] * b[0] + a[7] * b[3] + a[8] * b[6]
+    m21 = a[6] * b[1] + a[7] * b[4] + a[8] * b[7]
+    return (0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01))
+
+
+# ==========================================================================
+# § 10.2 exp and dexp^-1 on SO(3)
+# ==========================================================================
 
 def exp_so3(u):
-    """so3::exp: Rodrigues, Taylor series below theta^2 = 1e-8."""
-    x, y, z = u
-    t2 = x * x + y * y + z * z
+    """exp(hat(u)), Rodrigues' formula (a Taylor series near 0)."""
+    t2 = norm2(u)
     if t2 < 1e-8:
         a = 1.0 - t2 / 6.0 * (1.0 - t2 / 20.0)
         b = 0.5 - t2 / 24.0 * (1.0 - t2 / 30.0)
@@ -171,8 +272,9 @@ def exp_so3(u):
         t = math.sqrt(t2)
         a = math.sin(t) / t
         b = (1.0 - math.cos(t)) / t2
-    k = (0.0, -z, y, z, 0.0, -x, -y, x, 0.0)
+    k = hat(u)
     kk = mm(k, k)
+    # (I + K·a) + (K·K)·b, entry by entry
     return (1.0 + k[0] * a + kk[0] * b, 0.0 + k[1] * a + kk[1] * b,
             0.0 + k[2] * a + kk[2] * b, 0.0 + k[3] * a + kk[3] * b,
             1.0 + k[4] * a + kk[4] * b, 0.0 + k[5] * a + kk[5] * b,
@@ -181,138 +283,268 @@ def exp_so3(u):
 
 
 def dexp_inv(u, w):
-    """so3::dexp_inv: w + 1/2 u x w + c u x (u x w)."""
-    u0, u1, u2 = u
-    t2 = u0 * u0 + u1 * u1 + u2 * u2
+    """The inverse of the left-trivialised differential of exp:
+    w + 1/2 u x w + c u x (u x w)."""
+    t2 = norm2(u)
     if t2 < 1e-6:
         c = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0
     else:
         t = math.sqrt(t2)
-        half = 0.5 * t
-        c = (1.0 - half * math.cos(half) / math.sin(half)) / t2
+        h = 0.5 * t
+        c = (1.0 - h * math.cos(h) / math.sin(h)) / t2
     uw = cross(u, w)
-    uuw = cross(u, uw)
-    return (w[0] + uw[0] * 0.5 + uuw[0] * c, w[1] + uw[1] * 0.5 + uuw[1] * c,
-            w[2] + uw[2] * 0.5 + uuw[2] * c)
+    return add(add(w, scale(uw, 0.5)), scale(cross(u, uw), c))
 
 
-def orthogonality_defect(r):
-    """||R^T R - I||_F."""
-    m = mm(tuple(r[i] for i in (0, 3, 6, 1, 4, 7, 2, 5, 8)), r)
-    return math.sqrt(sum((m[i] - (1.0 if i in (0, 4, 8) else 0.0)) ** 2
-                         for i in range(9)))
+# ==========================================================================
+# § 10.3 RKMK4, one stage at a time
+# ==========================================================================
+
+RK_A = (0.5, 0.5, 1.0)  # a of stages 2-4 (c = [0, 1/2, 1/2, 1])
+RK_WEIGHT = (1.0, 2.0, 2.0, 1.0)
 
 
-def det3(r):
-    return (r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6])
-            + r[2] * (r[3] * r[7] - r[4] * r[6]))
+class Rkmk4:
+    """Runge-Kutta-Munthe-Kaas of order 4 on SO(3)^NR x R^3NV. `point` is
+    the current stage's evaluation point (rotations, vectors); `push` takes
+    the field there (a body rate per rotation, a derivative per vector)."""
+
+    def __init__(self, rotations, vectors, h):
+        self.h = h
+        self.begin(list(rotations), list(vectors))
+
+    def begin(self, rotations, vectors):
+        """The start of a step at (R^0, x^0)."""
+        self.r0, self.x0 = rotations, vectors
+        self.stage = 0
+        self.u = [ZERO] * len(rotations)
+        self.sum_u = [ZERO] * len(rotations)
+        self.sum_k = [ZERO] * len(vectors)
+        self.point = (rotations, vectors)
+
+    def push(self, omegas, ks):
+        """Moves to the next stage; True when the step is complete."""
+        s, h = self.stage, self.h
+        weight = RK_WEIGHT[s]
+        xs = []
+        for i, omega in enumerate(omegas):
+            big_u = dexp_inv(self.u[i], omega)
+            self.sum_u[i] = add(self.sum_u[i], scale(big_u, weight))
+            if s < 3:
+                self.u[i] = scale(big_u, h * RK_A[s])
+        for i, k in enumerate(ks):
+            self.sum_k[i] = add(self.sum_k[i], scale(k, weight))
+            if s < 3:
+                xs.append(add(self.x0[i], scale(k, h * RK_A[s])))
+        if s < 3:
+            self.stage = s + 1
+            self.point = ([mm(r, exp_so3(u)) for r, u in zip(self.r0, self.u)], xs)
+            return False
+        h6 = h / 6.0
+        self.begin([mm(r, exp_so3(scale(su, h6))) for r, su in zip(self.r0, self.sum_u)],
+                   [add(x, scale(sk, h6)) for x, sk in zip(self.x0, self.sum_k)])
+        return True
 
 
-H_FRACTION = (0.5, 0.5, 1.0)  # integrate.rs `A`: c of stages 2-4
-ZERO3 = (0.0, 0.0, 0.0)
+# ==========================================================================
+# § 10.6 The observers. `own` = (R_hat_i, w_hat_i, s_hat_i); `nbrs` = the held
+# (R_hat_j, w_hat_j, s_hat_j) with their gains A_j; `leader` = (A_0, (R_0,
+# w_0, s_0)) or None.
+# ==========================================================================
+
+def omega_hat_dot_7b(g, own, gains, nbrs, leader):
+    """(7b) dw_hat_i/dt = s_hat_i - k_R R_0^T psi(A_0 R_hat_i R_0^T) - k_w (w_hat_i - w_0)
+    - k_R sum_j R_hat_j^T psi(A_j R_hat_i R_hat_j^T) - k_w sum_j (w_hat_i - w_hat_j)."""
+    r_i, w_i, s_i = own
+    d = s_i
+    if leader is not None:
+        a0, (r0, w0, _) = leader
+        d = sub(d, scale(mv(tr(r0), psi_mm(mm(a0, r_i), tr(r0))), g["k_r"]))
+        d = sub(d, scale(sub(w_i, w0), g["k_w"]))
+    for a, (r_j, w_j, _) in zip(gains, nbrs):
+        d = sub(d, scale(mv(tr(r_j), psi_mm(mm(a, r_i), tr(r_j))), g["k_r"]))
+        d = sub(d, scale(sub(w_i, w_j), g["k_w"]))
+    return d
 
 
-class ObserverlessAgent:
-    """attitude::agent::Agent for Scheme::Observerless, one stage at a time:
-    `stage_exchange`, `receive`, `advance`, as the node loop drives it."""
+def sigma_hat_dot_7c(g, p, own, nbrs, leader):
+    """(7c) ds_hat_i/dt = P s_hat_i - k_sigma sum_j (s_hat_i - s_hat_j)
+    - k_sigma (s_hat_i - s_0)."""
+    s_i = own[2]
+    e = mv(p, s_i)
+    for (_, _, s_j) in nbrs:
+        e = sub(e, scale(sub(s_i, s_j), g["k_sigma"]))
+    if leader is not None:
+        e = sub(e, scale(sub(s_i, leader[1][2]), g["k_sigma"]))
+    return e
+
+
+def omega_hat_dot_16b(g, own, gains, nbrs, leader):
+    """(16b) dw_hat_i/dt = -k_R sum_j psi(A_j R_hat_j^T R_hat_i) - k_w sum_j (w_hat_i - w_hat_j)
+    - k_R psi(A_0 R_0^T R_hat_i) - k_w w_hat_i."""
+    r_i, w_i, _ = own
+    d = ZERO
+    for a, (r_j, w_j, _) in zip(gains, nbrs):
+        d = sub(d, scale(psi_mm(mm(a, tr(r_j)), r_i), g["k_r"]))
+        d = sub(d, scale(sub(w_i, w_j), g["k_w"]))
+    if leader is not None:
+        a0, (r0, _, _) = leader
+        d = sub(d, scale(psi_mm(mm(a0, tr(r0)), r_i), g["k_r"]))
+        d = sub(d, scale(w_i, g["k_w"]))
+    return d
+
+
+# ==========================================================================
+# § 10.7 The control laws (signs as corrected in docs/paper.md, erratum 1)
+# ==========================================================================
+
+def tracking_error(r, w, r_hat, w_hat):
+    """R_bar = R_hat^T R, v = R_bar^T w_hat, w_bar = w - v (Section timevarying)."""
+    r_bar = mm(tr(r_hat), r)
+    v = mv(tr(r_bar), w_hat)
+    return r_bar, v, sub(w, v)
+
+
+def sigma_i(j, v, w_bar):
+    """(sigmai, corrected) Sigma_i = (J w_bar)^x + (J v)^x - v^x J - J v^x."""
+    hv = hat(v)
+    return msub(msub(madd(hat(mv(j, w_bar)), hat(mv(j, v))), mm(hv, j)), mm(j, hv))
+
+
+def gamma_i(j, r_bar, v, w_hat_dot):
+    """(gammai, corrected) Gamma_i = -v x J v - J R_bar^T dw_hat/dt."""
+    return sub(neg(cross(v, mv(j, v))), mv(j, mv(tr(r_bar), w_hat_dot)))
+
+
+def pd(g, a_bar, r_bar, w_bar):
+    """k_R psi(A_bar R_bar) + k_w w_bar, shared by both observer-based laws."""
+    return add(scale(psi_mm(a_bar, r_bar), g["k_r"]), scale(w_bar, g["k_w"]))
+
+
+def tau_control(g, j, a_bar, error, w_hat_dot):
+    """(control) tau_i = -Sigma_i w_bar - Gamma_i - k_R psi(A_bar R_bar) - k_w w_bar."""
+    r_bar, v, w_bar = error
+    return sub(sub(mv(mneg(sigma_i(j, v, w_bar)), w_bar), gamma_i(j, r_bar, v, w_hat_dot)),
+               pd(g, a_bar, r_bar, w_bar))
+
+
+def tau_control_constant_estimate(g, j, a_bar, error, w_hat_dot):
+    """(controlconstantestimate) tau_i = -Gamma_i - k_R psi(A_bar R_bar) - k_w w_bar."""
+    r_bar, v, w_bar = error
+    return sub(neg(gamma_i(j, r_bar, v, w_hat_dot)), pd(g, a_bar, r_bar, w_bar))
+
+
+def tau_districontrol(g, r, w, gains, nbrs, leader):
+    """(districontrol) tau_i = -k_w w_i - k_R psi(A_0 R_0^T R_i) - k_R sum_j psi(A_j R_j^T R_i)."""
+    tau = scale(neg(w), g["k_w"])
+    if leader is not None:
+        a0, (r0, _, _) = leader
+        tau = sub(tau, scale(psi_mm(mm(a0, tr(r0)), r), g["k_r"]))
+    for a, (r_j, _, _) in zip(gains, nbrs):
+        tau = sub(tau, scale(psi_mm(mm(a, tr(r_j)), r), g["k_r"]))
+    return tau
+
+
+def omega_dot(j, j_inv, w, tau):
+    """(followeri) dw_i/dt = J^-1 (tau_i - w_i x J w_i)."""
+    return mv(j_inv, sub(tau, cross(w, mv(j, w))))
+
+
+# ==========================================================================
+# § 10.5, § 10.8 The agent
+# ==========================================================================
+
+class Agent:
+    """One follower, stage by stage, as the node loop drives it: `exchanged`
+    (what to publish), `receive` (a validated input), `advance` (evaluate the
+    stage with the held values and move on)."""
 
     def __init__(self, model, initial, dt):
-        self.k_r = float(model["scheme"]["control"]["k_r"])
-        self.k_w = float(model["scheme"]["control"]["k_w"])
+        self.scheme = model["scheme"]["kind"]
+        self.control = gains_of(model["scheme"]["control"])
+        self.observer = (gains_of(model["scheme"]["observer"])
+                         if self.scheme != "observerless" else None)
         self.j = matrix(model["inertia"]["j"])
-        self.j_inv = matrix(model["inertia"]["j_inv"])
+        self.j_inv = matrix(model["inertia"]["j_inv"])  # as given: never invert J (§ 10)
+        self.a_bar = matrix(model["a_bar"]) if self.observer else None
+        self.p = matrix(model["p"]) if self.scheme == "observer-time-varying" else None
         self.gains = [matrix(n["a"]) for n in model["neighbours"]]
         self.leader_gain = (None if model.get("leader_gain") is None
                             else matrix(model["leader_gain"]))
-        identity = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-        self.held_nbrs = [identity] * len(self.gains)  # neighbours' R_j
-        self.held_leader = identity  # R_0, if linked
-        self.dt = dt
-        self.h6 = dt / 6.0
-        self.h_a = tuple(dt * a for a in H_FRACTION)
+        # Held values (R, w, s) per neighbour, then the leader: (I, 0, 0)
+        # until something valid arrives (§ 8).
+        self.held = [(IDENTITY, ZERO, ZERO)] * (len(self.gains) + (self.leader_gain is not None))
         self.peak_torque = 0.0
-        # The observer part of the state is constant in this scheme
-        # (identity, 0, 0 from the orchestrator); reported as is.
-        self.r_hat = matrix(initial["r_hat"])
-        self.w_hat = vec3(initial["w_hat"])
-        self.s_hat = vec3(initial["s_hat"])
-        self._begin_step(matrix(initial["r"]), vec3(initial["w"]))
+        r, w = matrix(initial["r"]), vec3(initial["w"])
+        r_hat = matrix(initial["r_hat"])
+        w_hat, s_hat = vec3(initial["w_hat"]), vec3(initial["s_hat"])
+        if self.observer:
+            self.rk = Rkmk4([r, r_hat], [w, w_hat, s_hat], dt)
+        else:
+            # The observerless scheme integrates R_hat, w_hat, s_hat with
+            # zero rates: they stay the configured values (§ 10.8).
+            self.rk = Rkmk4([r], [w], dt)
+            self.constant_hat = (r_hat, w_hat, s_hat)
 
-    def _begin_step(self, r, w):
-        """Rkmk4::new(y0, h): the state at the start of a step."""
-        self.r0, self.w0 = r, w
-        self.stage = 0
-        self.u = ZERO3  # Lie-algebra increment of the current stage
-        self.sum_u = ZERO3
-        self.sum_k = ZERO3
-        self.r_stage, self.w_stage = r, w  # Rkmk4::stage_state
+    def state(self):
+        """(R_i, w_i, R_hat_i, w_hat_i, s_hat_i) at the current stage point."""
+        rots, vecs = self.rk.point
+        if self.observer:
+            return rots[0], vecs[0], rots[1], vecs[1], vecs[2]
+        r_hat, w_hat, s_hat = self.constant_hat
+        return rots[0], vecs[0], r_hat, w_hat, s_hat
 
-    def stage_exchange(self):
-        """What the agent publishes at the current stage: (R, w, 0)."""
-        return self.r_stage, self.w_stage
+    def exchanged(self):
+        """What the agent publishes at this stage: (R_hat, w_hat, s_hat) with
+        an observer, (R, w, 0) without (§ 10.5)."""
+        r, w, r_hat, w_hat, s_hat = self.state()
+        return (r_hat, w_hat, s_hat) if self.observer else (r, w, ZERO)
 
-    def receive(self, k, r):
-        if k < len(self.held_nbrs):
-            self.held_nbrs[k] = r
-        elif self.leader_gain is not None:
-            self.held_leader = r
+    def receive(self, k, value):
+        """Holds the valid value (R, w, s) of input k (the order of `inputs`)."""
+        self.held[k] = value
 
     def advance(self):
-        """Evaluates the field at the stage state with the held inputs
-        (agent_field / tau_districontrol / omega_dot) and pushes it into
-        RKMK4 (Rkmk4::push_derivative)."""
-        r, w = self.r_stage, self.w_stage
-        k_r = self.k_r
-        k_w = self.k_w
-        # tau = -w k_w - k_R psi(A_i0 R0^T R) - k_R sum_j psi(A_ij Rj^T R)
-        t0, t1, t2 = -w[0] * k_w, -w[1] * k_w, -w[2] * k_w
-        if self.leader_gain is not None:
-            p0, p1, p2 = psi_of_product(mm_transposed(self.leader_gain, self.held_leader), r)
-            t0, t1, t2 = t0 - p0 * k_r, t1 - p1 * k_r, t2 - p2 * k_r
-        for a, rj in zip(self.gains, self.held_nbrs):
-            p0, p1, p2 = psi_of_product(mm_transposed(a, rj), r)
-            t0, t1, t2 = t0 - p0 * k_r, t1 - p1 * k_r, t2 - p2 * k_r
-        s = self.stage
-        if s == 0:
-            norm = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-            if norm > self.peak_torque:
-                self.peak_torque = norm
-        # J w_dot = -w x J w + tau
-        c = cross(w, mv(self.j, w))
-        w_dot = mv(self.j_inv, (t0 - c[0], t1 - c[1], t2 - c[2]))
-        # RKMK4, rotation part: U = dexp_inv(u, w); vector part: k = w_dot.
-        big_u = dexp_inv(self.u, w)
-        weight = 1.0 if s == 0 or s == 3 else 2.0
-        su, sk = self.sum_u, self.sum_k
-        self.sum_u = (su[0] + big_u[0] * weight, su[1] + big_u[1] * weight,
-                      su[2] + big_u[2] * weight)
-        self.sum_k = (sk[0] + w_dot[0] * weight, sk[1] + w_dot[1] * weight,
-                      sk[2] + w_dot[2] * weight)
-        if s < 3:
-            ha = self.h_a[s]
-            self.u = (big_u[0] * ha, big_u[1] * ha, big_u[2] * ha)
-            w0 = self.w0
-            self.w_stage = (w0[0] + w_dot[0] * ha, w0[1] + w_dot[1] * ha,
-                            w0[2] + w_dot[2] * ha)
-            self.r_stage = mm(self.r0, exp_so3(self.u))
-            self.stage = s + 1
-            return False
-        h6 = self.h6
-        su, sk, w0 = self.sum_u, self.sum_k, self.w0
-        r_next = mm(self.r0, exp_so3((su[0] * h6, su[1] * h6, su[2] * h6)))
-        w_next = (w0[0] + sk[0] * h6, w0[1] + sk[1] * h6, w0[2] + sk[2] * h6)
-        self._begin_step(r_next, w_next)
-        return True
+        """§ 10.8: evaluates the stage and pushes it into RKMK4; True when a
+        step is complete."""
+        r, w, r_hat, w_hat, s_hat = self.state()
+        n = len(self.gains)
+        nbrs = self.held[:n]
+        leader = (self.leader_gain, self.held[n]) if self.leader_gain is not None else None
+        own = (r_hat, w_hat, s_hat)
+        if self.scheme == "observer-time-varying":
+            w_hat_dot = omega_hat_dot_7b(self.observer, own, self.gains, nbrs, leader)
+            s_hat_dot = sigma_hat_dot_7c(self.observer, self.p, own, nbrs, leader)
+            error = tracking_error(r, w, r_hat, w_hat)
+            tau = tau_control(self.control, self.j, self.a_bar, error, w_hat_dot)
+        elif self.scheme == "observer-constant":
+            w_hat_dot = omega_hat_dot_16b(self.observer, own, self.gains, nbrs, leader)
+            s_hat_dot = ZERO
+            error = tracking_error(r, w, r_hat, w_hat)
+            tau = tau_control_constant_estimate(self.control, self.j, self.a_bar, error,
+                                                w_hat_dot)
+        else:
+            tau = tau_districontrol(self.control, r, w, self.gains, nbrs, leader)
+        if self.rk.stage == 0:  # only the torque at a step's start counts
+            self.peak_torque = max(self.peak_torque, norm(tau))
+        w_dot = omega_dot(self.j, self.j_inv, w, tau)
+        if self.observer:
+            return self.rk.push([w, w_hat], [w_dot, w_hat_dot, s_hat_dot])
+        return self.rk.push([w], [w_dot])
 
     def sample(self, node_id, step):
-        """TelemetryMsg::agent: the state at the start of the current step."""
-        return TELEMETRY.pack(PROTOCOL_VERSION, node_id, step, SAMPLE, 0,
-                              *self.r0, *self.w0, *self.r_hat, *self.w_hat,
-                              *self.s_hat, self.peak_torque)
+        """Telemetry Sample: the state at the start of the current step."""
+        r, w, r_hat, w_hat, s_hat = self.state()
+        return telemetry(node_id, SAMPLE, SAMPLE_BODY, step, *r, *w, *r_hat, *w_hat,
+                         *s_hat, self.peak_torque)
+
+
+def gains_of(g):
+    return {key: float(g[key]) for key in ("k_r", "k_w", "k_sigma") if key in g}
 
 
 def matrix(x):
-    """A nalgebra Matrix3 from its serde form: 9 numbers, column-major."""
+    """A matrix of the configuration: 9 numbers, column-major (§ 2)."""
     if len(x) != 9:
         raise NodeError(f"invalid node config: a matrix has {len(x)} entries, not 9", 2)
     m = [float(v) for v in x]
@@ -325,9 +557,71 @@ def vec3(x):
     return tuple(float(v) for v in x)
 
 
-# --------------------------------------------------------------------------
-# Configuration (msgs/src/config.rs)
-# --------------------------------------------------------------------------
+# ==========================================================================
+# § 8 Values from other processes are not trusted
+# ==========================================================================
+
+def rotation_defect(r):
+    """||R^T R - I||_F, column by column."""
+    m = msub(mm(tr(r), r), IDENTITY)
+    n = [m[c] * m[c] + m[3 + c] * m[3 + c] + m[6 + c] * m[6 + c] for c in range(3)]
+    return math.sqrt(n[0] + n[1] + n[2])
+
+
+def det(r):
+    return (r[0] * (r[4] * r[8] - r[7] * r[5]) - r[1] * (r[3] * r[8] - r[6] * r[5])
+            + r[2] * (r[3] * r[7] - r[6] * r[4]))
+
+
+def validated(m):
+    """The (R, w, s) of an unpacked StateMsg if all 15 numbers are finite and
+    R is a rotation, else None."""
+    values = m[6:]
+    if not all(map(math.isfinite, values)):
+        return None
+    r = values[:9]
+    if rotation_defect(r) > ROTATION_TOLERANCE or det(r) <= 0.0:
+        return None
+    return r, values[9:12], values[12:15]
+
+
+def why_invalid(m):
+    if not all(math.isfinite(v) for v in m[6:]):
+        return "a value is NaN or infinite"
+    return (f"the attitude is not a rotation (||R^T R - I|| = "
+            f"{rotation_defect(m[6:15]):.3e}, det R = {det(m[6:15]):.3e})")
+
+
+def check_origin(m, sender):
+    """Version and sender of a message on `sender`'s state service."""
+    if m[0] != PROTOCOL_VERSION:
+        raise NodeError(f"protocol violation: node {sender} speaks protocol version {m[0]}, "
+                        f"this node {PROTOCOL_VERSION}", failed=(FAIL_BAD_INPUT, sender))
+    if m[1] != sender:
+        raise NodeError(f"protocol violation: a message on node {sender}'s state service "
+                        f"claims sender {m[1]}", failed=(FAIL_BAD_INPUT, sender))
+
+
+class Refusals:
+    """Messages refused per input (§ 8), with one warning per input."""
+
+    def __init__(self, inputs):
+        self.inputs = inputs
+        self.count = [0] * len(inputs)
+
+    def accept(self, k, m):
+        value = validated(m)
+        if value is None:
+            if self.count[k] == 0:
+                log(f"WARN refused a state from node {self.inputs[k]} at step {m[2]} stage "
+                    f"{m[3]}: {why_invalid(m)} (further refusals are only counted)")
+            self.count[k] += 1
+        return value
+
+
+# ==========================================================================
+# § 2 The configuration
+# ==========================================================================
 
 def config_path(argv):
     path = None
@@ -351,39 +645,36 @@ def config_path(argv):
 
 def read_config(path):
     try:
-        return _read_config(path)
-    except (KeyError, TypeError, ValueError, AttributeError) as e:
-        raise NodeError(f"{path}: invalid node config: {e!r}", 2) from e
-
-
-def _read_config(path):
-    try:
         with open(path, encoding="utf-8") as f:
             cfg = json.load(f)  # floats: correctly rounded, exact round trip
     except OSError as e:
         raise NodeError(f"{path}: cannot read: {e}", 2) from e
     except ValueError as e:
         raise NodeError(f"{path}: invalid node config: {e}", 2) from e
-    version = cfg.get("protocol_version")
+    version = cfg.get("protocol_version") if isinstance(cfg, dict) else None
     if version != PROTOCOL_VERSION:
         raise NodeError(f"{path}: protocol version {version} but this program "
                         f"speaks {PROTOCOL_VERSION}", 2)
+    try:
+        check_config(path, cfg)
+    except (KeyError, TypeError, ValueError, AttributeError) as e:
+        raise NodeError(f"{path}: invalid node config: {e!r}", 2) from e
+    return cfg
+
+
+def check_config(path, cfg):
+    """Refuses (exit 2) what this agent does not implement."""
     unsupported = []
-    if cfg.get("realtime") is not None:
-        unsupported.append(f"real-time mode (realtime = {cfg['realtime']}) is not "
-                           "supported by the Python agent: run in lockstep")
-    role = cfg.get("role", {})
+    role = cfg["role"]
     if role.get("kind") != "agent":
-        unsupported.append(f"role {role.get('kind')!r}: the Python agent is a follower "
-                           "agent only")
+        unsupported.append(f"role {role.get('kind')!r}: the Python agent is a follower only")
     else:
         model = role["model"]
         kind = model["scheme"]["kind"]
-        if kind != "observerless":
-            unsupported.append(f"scheme {kind!r} is not supported: the Python agent "
-                               "implements the observerless scheme (districontrol) only")
+        if kind not in SCHEMES:
+            unsupported.append(f"unknown scheme {kind!r}")
         links = [n.get("link") for n in model["neighbours"]] + [model.get("leader_link")]
-        if any(link_impaired(l) for l in links):
+        if any(link is not None for link in links):
             unsupported.append("impaired links (delay, jitter, loss, period) are not "
                                "supported by the Python agent")
         expected = [n["id"] for n in model["neighbours"]]
@@ -392,41 +683,34 @@ def _read_config(path):
         if list(cfg["inputs"]) != expected:
             raise NodeError(f"{path}: inputs {cfg['inputs']} do not match the model's "
                             f"neighbours and leader link {expected}", 2)
-    mode = cfg.get("coupling", {}).get("mode")
+    mode = cfg["coupling"]["mode"]
     if mode not in ("continuous", "sampled"):
         unsupported.append(f"coupling {mode!r} is not supported")
     elif mode == "sampled" and int(cfg["coupling"]["every"]) < 1:
         raise NodeError(f"{path}: coupling.every must be >= 1", 2)
-    if int(cfg.get("sample_every", 0)) < 1:
+    if int(cfg["sample_every"]) < 1:
         raise NodeError(f"{path}: sample_every must be >= 1", 2)
+    factor = cfg.get("realtime")
+    if factor is not None and not float(factor) > 0.0:
+        raise NodeError(f"{path}: realtime must be a factor > 0, not {factor}", 2)
     if unsupported:
         raise NodeError(f"{path}: " + "; ".join(unsupported), 2)
-    return cfg
-
-
-def link_impaired(link):
-    """LinkModel::is_impaired (None: an ideal link)."""
-    if link is None:
-        return False
-    return (link.get("delay", 0) > 0 or link.get("jitter", 0) > 0
-            or link.get("loss", {"kind": "none"}).get("kind", "none") != "none"
-            or link.get("period") is not None)
 
 
 def exchanges_at(coupling, step, stage):
-    """Coupling::exchanges_at."""
+    """Whether (step, stage) is an exchange (§ 2, `coupling`)."""
     if coupling["mode"] == "continuous":
         return True
     return stage == 0 and step % coupling["every"] == 0
 
 
-# --------------------------------------------------------------------------
-# iceoryx2 ports (msgs/src/{namespace,names,open}.rs, agent/src/runtime/ports.rs)
-# --------------------------------------------------------------------------
+# ==========================================================================
+# § 3, § 4 iceoryx2 ports
+# ==========================================================================
 
 def open_service(name, make):
-    """open_or_create, retried for 2 s like msgs::open::retry: two processes
-    creating the same service at once make one of them fail transiently."""
+    """open_or_create, retried for 2 s: two processes creating the same
+    service at once make one of them fail transiently."""
     start = time.monotonic()
     while True:
         try:
@@ -438,15 +722,19 @@ def open_service(name, make):
 
 
 class Ports:
-    """Every port of the node, opened with the limits of msgs/src/open.rs."""
+    """Every port of the node, with the settings of § 4."""
 
     def __init__(self, iox2, cfg):
         self.iox2 = iox2
         run, node_id, lim = cfg["run"], cfg["id"], cfg["limits"]
         fanout, nodes = lim["max_fanout"], lim["nodes"]
         state_buffer, telemetry_buffer = lim["state_buffer"], lim["telemetry_buffer"]
+        retry = iox2.BackpressureStrategy.RetryUntilDelivered
+        # Lockstep: a full receiver holds the sender back (flow control).
+        # Real time: a receiver that falls behind misses messages instead.
+        state_strategy = retry if cfg["realtime"] is None else iox2.BackpressureStrategy.DiscardData
 
-        # Per-run namespace (msgs::namespace::config).
+        # The run's namespace (§ 3).
         ioxcfg = iox2.config.default()
         root = cfg["iox_root"]
         if not root.endswith("/"):
@@ -459,54 +747,45 @@ class Ports:
                      .signal_handling_mode(iox2.SignalHandlingMode.Disabled)
                      .create(iox2.ServiceType.Ipc))
 
+        def service(name):
+            return self.node.service_builder(iox2.ServiceName.new(f"attsync/{run}/{name}"))
+
         def state(j):
-            name = f"attsync/{run}/node/{j}/state"
-            return open_service(name, lambda: (
-                self.node.service_builder(iox2.ServiceName.new(name))
-                .publish_subscribe(StateMsg)
+            return open_service(f"node/{j}/state", lambda: (
+                service(f"node/{j}/state").publish_subscribe(StateMsg)
                 .max_publishers(1).max_subscribers(fanout).max_nodes(fanout + 2)
                 .history_size(0).subscriber_max_buffer_size(state_buffer)
                 .subscriber_max_borrowed_samples(2).enable_safe_overflow(False)
                 .open_or_create()))
 
         def wake(j):
-            name = f"attsync/{run}/node/{j}/wake"
-            return open_service(name, lambda: (
-                self.node.service_builder(iox2.ServiceName.new(name)).event()
+            return open_service(f"node/{j}/wake", lambda: (
+                service(f"node/{j}/wake").event()
                 .max_listeners(1).max_notifiers(fanout + 1).max_nodes(fanout + 3)
                 .open_or_create()))
 
-        # Our state: the publisher holds a full receiver back (flow control).
         # NOTE: the Python binding has no backpressure handler, so unlike the
-        # Rust node this retry is not bounded by the stage timeout; an agent's
-        # receivers are also its inputs, so it is never more than one
-        # exchange ahead of them and their buffer (64) never fills.
+        # Rust node RetryUntilDelivered is not bounded by the stage timeout;
+        # an agent's receivers are also its inputs, so it is never more than
+        # one exchange ahead of them and their buffer never fills.
         self.own = state(node_id)
-        self.publisher = (self.own.publisher_builder()
-                          .backpressure_strategy(iox2.BackpressureStrategy.RetryUntilDelivered)
-                          .create())
-        self.listener = wake(node_id).listener_builder().create()
-        name = f"attsync/{run}/node/{node_id}/telemetry"
-        self.tele = open_service(name, lambda: (
-            self.node.service_builder(iox2.ServiceName.new(name))
-            .publish_subscribe(TelemetryMsg)
+        self.publisher = self.own.publisher_builder().backpressure_strategy(state_strategy).create()
+        self.own_wake = wake(node_id)
+        self.listener = self.own_wake.listener_builder().create()
+        self.tele = open_service(f"node/{node_id}/telemetry", lambda: (
+            service(f"node/{node_id}/telemetry").publish_subscribe(TelemetryMsg)
             .max_publishers(1).max_subscribers(2).max_nodes(4)
             .history_size(0).subscriber_max_buffer_size(telemetry_buffer)
             .subscriber_max_borrowed_samples(2).enable_safe_overflow(False)
             .open_or_create()))
-        self.tele_pub = (self.tele.publisher_builder()
-                         .backpressure_strategy(iox2.BackpressureStrategy.RetryUntilDelivered)
-                         .create())
-        name = f"attsync/{run}/orchestrator/wake"
-        self.orch_wake = open_service(name, lambda: (
-            self.node.service_builder(iox2.ServiceName.new(name)).event()
+        self.tele_pub = self.tele.publisher_builder().backpressure_strategy(retry).create()
+        self.orch_wake = open_service("orchestrator/wake", lambda: (
+            service("orchestrator/wake").event()
             .max_listeners(1).max_notifiers(nodes + 1).max_nodes(nodes + 2)
             .open_or_create()))
         self.orch_notifier = self.orch_wake.notifier_builder().create()
-        name = f"attsync/{run}/control"
-        self.control_svc = open_service(name, lambda: (
-            self.node.service_builder(iox2.ServiceName.new(name))
-            .publish_subscribe(ControlMsg)
+        self.control_svc = open_service("control", lambda: (
+            service("control").publish_subscribe(ControlMsg)
             .max_publishers(1).max_subscribers(nodes + 1).max_nodes(nodes + 2)
             .history_size(2).subscriber_max_buffer_size(4)
             .open_or_create()))
@@ -518,8 +797,9 @@ class Ports:
         self.notifiers = [s.notifier_builder().create() for s in self.wake_services]
 
     def await_connections(self, cfg, orphan):
-        """Readiness barrier: every receiver of our state, the orchestrator's
-        telemetry subscriber and the sender of every input are connected."""
+        """§ 6.3 Readiness barrier: every receiver of our state, the
+        orchestrator's telemetry subscriber and the sender of every input
+        are connected."""
         timeout = float(cfg["start_timeout"])
         ready_by = time.monotonic() + timeout
         n_out = len(cfg["outputs"])
@@ -543,18 +823,40 @@ class Ports:
                                 f"without a publisher {missing})")
             time.sleep(0.001)
 
+    def publish(self, payload, notify=True):
+        """Sends our state (packed STATE bytes) and wakes every receiver."""
+        loan = self.publisher.loan_uninit()
+        ctypes.memmove(loan.payload_ptr, payload, STATE.size)
+        loan.assume_init().send()
+        if notify:
+            for nt in self.notifiers:
+                try:
+                    nt.notify()
+                except Exception:  # a lost wake-up only delays a receiver
+                    pass
+
+    def take(self, k):
+        """One message of input k, unpacked, or None."""
+        sample = self.inputs[k].receive()
+        if sample is None:
+            return None
+        m = STATE.unpack(ctypes.string_at(sample.payload_ptr, STATE.size))
+        sample.delete()
+        return m
+
     def report(self, payload):
-        """Sends a telemetry message (packed TELEMETRY bytes) and wakes the orchestrator."""
-        sample = self.tele_pub.loan_uninit()
-        ctypes.memmove(sample.payload_ptr, payload, TELEMETRY.size)
-        sample.assume_init().send()
+        """Sends a telemetry message (TelemetryMsg bytes) and wakes the orchestrator."""
+        loan = self.tele_pub.loan_uninit()
+        ctypes.memmove(loan.payload_ptr, payload, TELEMETRY_SIZE)
+        loan.assume_init().send()
         try:
             self.orch_notifier.notify()
         except Exception:  # a lost wake-up only delays the orchestrator
             pass
 
     def release(self):
-        """Releases every port, then the services and the node."""
+        """§ 3 Leaving cleanly: delete every port, drop every service and the
+        node, and collect, so that nothing of ours is left in iceoryx2."""
         ports = ([self.publisher, self.listener, self.tele_pub, self.orch_notifier,
                   self.control] + self.inputs + self.notifiers)
         for p in ports:
@@ -562,10 +864,12 @@ class Ports:
                 p.delete()
             except Exception:
                 pass
-        self.inputs, self.notifiers, self.input_services, self.wake_services = [], [], [], []
+        self.inputs = self.notifiers = self.input_services = self.wake_services = []
         self.publisher = self.listener = self.tele_pub = self.orch_notifier = None
-        self.control = self.own = self.tele = self.orch_wake = self.control_svc = None
+        self.control = self.control_svc = self.own = self.own_wake = None
+        self.tele = self.orch_wake = None
         self.node = None
+        gc.collect()
 
 
 class Orphan:
@@ -580,7 +884,8 @@ class Orphan:
 
 
 def wait_command(ports, timeout, orphan):
-    """Polls the control service every millisecond (bounded) for a command."""
+    """Polls the control service every millisecond (bounded) for a command:
+    (command, start_unix_ns)."""
     deadline = time.monotonic() + timeout
     while True:
         sample = ports.control.receive()
@@ -599,150 +904,243 @@ def wait_command(ports, timeout, orphan):
         time.sleep(0.001)
 
 
-# --------------------------------------------------------------------------
-# The node loop (agent/src/runtime/{mod,lockstep}.rs)
-# --------------------------------------------------------------------------
+def state_msg(node_id, n, s, value, sent_ns=0):
+    """A StateMsg's bytes: (R, w, s) stamped (n, s)."""
+    r, w, sv = value
+    return STATE.pack(PROTOCOL_VERSION, node_id, n, s, 0, sent_ns, *r, *w, *sv)
 
-def lockstep(ports, cfg, agent, orphan):
-    """Steps `steps` steps in lockstep (agent/src/runtime/lockstep.rs).
-    Returns the messages refused per input and waiting statistics."""
-    iox2 = ports.iox2
-    node_id, steps = cfg["id"], int(cfg["steps"])
-    sample_every, coupling = int(cfg["sample_every"]), cfg["coupling"]
-    continuous = coupling["mode"] == "continuous"
-    inputs_ids = list(cfg["inputs"])
-    stage_timeout = float(cfg["stage_timeout"])
-    strategy = cfg.get("wait", "adaptive")
-    # Polls between sleeps: -1 never sleeps (spin and yield both call
-    # sched_yield here: a spinning Python process would starve its peers).
-    yields = {"spin": -1, "yield": -1, "block": 0}.get(strategy, ADAPTIVE_YIELDS)
-    subs = ports.inputs
-    listener, notifiers, publisher = ports.listener, ports.notifiers, ports.publisher
-    slice_ = iox2.Duration.from_millis(BLOCK_SLICE_MS)
-    rejected = [0] * len(subs)
-    n_yields = n_sleeps = 0
-    waited = 0.0
-    string_at, memmove, monotonic = ctypes.string_at, ctypes.memmove, time.monotonic
-    sched_yield, unpack = os.sched_yield, STATE.unpack
-    pack_into_bytes = STATE.pack
-    ssize = STATE.size
 
+# ==========================================================================
+# § 6 Lockstep
+# ==========================================================================
+
+class Waiter:
+    """How to wait for an input (`wait` of the configuration): a few
+    sched_yield()s, then sleeps on our wake event in 1 ms slices."""
+
+    def __init__(self, ports, cfg):
+        self.listener = ports.listener
+        self.slice = ports.iox2.Duration.from_millis(BLOCK_SLICE_MS)
+        # -1 never sleeps (spin and yield both call sched_yield here: a
+        # spinning Python process would starve its peers).
+        self.yields = {"spin": -1, "yield": -1, "block": 0}.get(cfg.get("wait"), ADAPTIVE_YIELDS)
+        self.polls = 0
+
+    def wait(self):
+        self.polls += 1
+        if self.yields < 0 or self.polls <= self.yields:
+            os.sched_yield()
+        else:
+            self.listener.timed_wait(self.slice)
+
+
+def await_input(ports, k, cfg, n, s, orphan):
+    """§ 6.7.3: one message of input k, waiting at most `stage_timeout`."""
+    m = ports.take(k)
+    if m is not None:
+        return m
+    waiter = Waiter(ports, cfg)
+    deadline = time.monotonic() + float(cfg["stage_timeout"])
+    while True:
+        waiter.wait()
+        m = ports.take(k)
+        if m is not None:
+            return m
+        if waiter.polls % 64 == 0 or waiter.polls > waiter.yields >= 0:
+            if time.monotonic() > deadline:
+                sender = cfg["inputs"][k]
+                raise NodeError(f"timed out after {cfg['stage_timeout']:.1f} s waiting for "
+                                f"node {sender}'s state of step {n} stage {s}",
+                                failed=(FAIL_TIMEOUT, sender))
+            if waiter.polls % 256 == 0:
+                orphan.check()
+
+
+def lockstep(ports, cfg, agent, refusals, orphan):
+    """Steps `steps` steps in lockstep; returns the pacing (0, 0.0)."""
+    node_id, steps, sample_every = cfg["id"], int(cfg["steps"]), int(cfg["sample_every"])
+    inputs = cfg["inputs"]
     ports.report(agent.sample(node_id, 0))
     for n in range(steps):
         if n % 256 == 0:
             orphan.check()
         for s in range(4):
-            if continuous or (s == 0 and n % coupling["every"] == 0):
-                r, w = agent.stage_exchange()
-                msg = pack_into_bytes(PROTOCOL_VERSION, node_id, n, s, 0, 0, *r, *w, 0.0,
-                                      0.0, 0.0)
-                loan = publisher.loan_uninit()
-                memmove(loan.payload_ptr, msg, ssize)
-                loan.assume_init().send()
-                # Wake every receiver (PROTOCOL.md § 6; attsync's own nodes
-                # skip it when every node busy-polls, with --wait spin|yield).
-                for nt in notifiers:
-                    try:
-                        nt.notify()
-                    except Exception:
-                        pass
-                deadline = None
-                polls = 0
-                t_wait = None
-                for k, sub in enumerate(subs):
-                    while True:
-                        sample = sub.receive()
-                        if sample is not None:
-                            m = unpack(string_at(sample.payload_ptr, ssize))
-                            sample.delete()
-                            break
-                        if deadline is None:
-                            t_wait = monotonic()
-                            deadline = t_wait + stage_timeout
-                        polls += 1
-                        if yields < 0 or polls <= yields:
-                            sched_yield()
-                            n_yields += 1
-                        else:
-                            listener.timed_wait(slice_)
-                            n_sleeps += 1
-                        # The clock every poll once sleeping, else every 64 polls.
-                        if (0 <= yields < polls or polls % 64 == 0) and monotonic() > deadline:
-                            # Failed names the silent input for the orchestrator.
-                            try:
-                                ports.report(TELEMETRY.pack(PROTOCOL_VERSION, node_id,
-                                                            inputs_ids[k], FAILED, 0,
-                                                            *([0.0] * 28)))
-                            except Exception:
-                                pass
-                            raise NodeError(
-                                f"timed out after {stage_timeout:.1f} s waiting for node "
-                                f"{inputs_ids[k]}'s state of step {n} stage {s}")
-                        if polls % 256 == 0:
-                            orphan.check()
-                    check_message(m, inputs_ids[k], n, s)
-                    value = validated(m)
-                    if value is None:
-                        # A refused value is like a lost message: keep what we had.
-                        if rejected[k] == 0:
-                            log(f"WARN refused a state from node {inputs_ids[k]} at step "
-                                f"{n} stage {s}: {why_invalid(m)} (further refusals are "
-                                "only counted)")
-                        rejected[k] += 1
-                    else:
+            if exchanges_at(cfg["coupling"], n, s):
+                ports.publish(state_msg(node_id, n, s, agent.exchanged()))
+                for k, sender in enumerate(inputs):
+                    m = await_input(ports, k, cfg, n, s, orphan)
+                    check_origin(m, sender)
+                    if (m[2], m[3]) != (n, s):
+                        raise NodeError(f"protocol violation: node {sender} sent step {m[2]} "
+                                        f"stage {m[3]} where step {n} stage {s} was due",
+                                        failed=(FAIL_BAD_INPUT, sender))
+                    value = refusals.accept(k, m)
+                    if value is not None:  # a refused value is like a lost one
                         agent.receive(k, value)
-                if t_wait is not None:
-                    waited += monotonic() - t_wait
             agent.advance()
-        done = n + 1
-        if done % sample_every == 0 or done == steps:
-            ports.report(agent.sample(node_id, done))
-    return rejected, {"yields": n_yields, "sleeps": n_sleeps, "wait_s": waited}
+        if (n + 1) % sample_every == 0 or n + 1 == steps:
+            ports.report(agent.sample(node_id, n + 1))
+    return 0, 0.0
 
 
-def check_message(m, sender, n, s):
-    """Version, sender and stamp of a message on `sender`'s state service."""
-    version, claimed, step, stage = m[0], m[1], m[2], m[3]
-    if version != PROTOCOL_VERSION:
-        raise NodeError(f"protocol violation: node {sender} speaks protocol version "
-                        f"{version}, this node {PROTOCOL_VERSION}")
-    if claimed != sender:
-        raise NodeError(f"protocol violation: message on node {sender}'s state service "
-                        f"claims sender {claimed}")
-    if step != n or stage != s:
-        raise NodeError(f"protocol violation: node {sender} sent step {step} stage {stage} "
-                        f"where step {n} stage {s} was due")
+# ==========================================================================
+# § 7 Real time
+# ==========================================================================
+
+STAGE_C = (0.0, 0.5, 0.5, 1.0)
 
 
-_isfinite = math.isfinite
+class LinkMeter:
+    """The measured counters of one input in real time (LinkStats, § 5)."""
+
+    def __init__(self):
+        self.newest = None  # (step, stage) of the newest message seen
+        self.held_sent_ns = None  # sent_unix_ns of the value held
+        self.delivered = self.evaluations = 0
+        self.age_sum = self.age_max = 0.0
+
+    def age(self, factor):
+        """Counts the age of information of the held value, simulated s."""
+        if self.held_sent_ns is not None:
+            age = max(unix_ns() - self.held_sent_ns, 0) * 1e-9 * factor
+            self.age_sum += age
+            self.age_max = max(self.age_max, age)
+            self.evaluations += 1
 
 
-def validated(m):
-    """StateMsg::validated: R if every number is finite and R is a rotation
-    (||R^T R - I||_F <= ROTATION_TOLERANCE and det R > 0), else None."""
-    values = m[6:]
-    if not all(map(_isfinite, values)):
-        return None
-    r0, r1, r2, r3, r4, r5, r6, r7, r8 = r = values[:9]
-    # R^T R - I, symmetric: 3 diagonal and 3 off-diagonal entries.
-    d00 = r0 * r0 + r3 * r3 + r6 * r6 - 1.0
-    d11 = r1 * r1 + r4 * r4 + r7 * r7 - 1.0
-    d22 = r2 * r2 + r5 * r5 + r8 * r8 - 1.0
-    d01 = r0 * r1 + r3 * r4 + r6 * r7
-    d02 = r0 * r2 + r3 * r5 + r6 * r8
-    d12 = r1 * r2 + r4 * r5 + r7 * r8
-    defect2 = d00 * d00 + d11 * d11 + d22 * d22 + 2.0 * (d01 * d01 + d02 * d02 + d12 * d12)
-    if defect2 > ROTATION_TOLERANCE * ROTATION_TOLERANCE or det3(r) <= 0.0:
-        return None
-    return r
+def drain(ports, k, meter, refusals, sender):
+    """Takes everything input k has; the newest valid (value, sent_unix_ns) or None."""
+    fresh = None
+    while True:
+        m = ports.take(k)
+        if m is None:
+            return fresh
+        check_origin(m, sender)
+        if meter.newest is not None and meter.newest >= (m[2], m[3]):
+            continue  # older than what we have seen
+        meter.newest = (m[2], m[3])
+        value = refusals.accept(k, m)
+        if value is not None:
+            meter.delivered += 1
+            fresh = (value, m[5])
 
 
-def why_invalid(m):
-    if not all(math.isfinite(v) for v in m[6:]):
-        return "a value is NaN or infinite"
-    r = m[6:15]
-    return (f"the attitude is not a rotation (||R^T R - I|| = "
-            f"{orthogonality_defect(r):.3e}, or det R <= 0)")
+def first_states(ports, k, meter, refusals, cfg, orphan):
+    """At (0, 0) only: waits (bounded) until input k's first state arrives."""
+    sender = cfg["inputs"][k]
+    deadline = time.monotonic() + float(cfg["stage_timeout"])
+    fresh = drain(ports, k, meter, refusals, sender)
+    while meter.newest is None:
+        if time.monotonic() > deadline:
+            raise NodeError(f"timed out after {cfg['stage_timeout']:.1f} s waiting for node "
+                            f"{sender}'s state of step 0 stage 0",
+                            failed=(FAIL_TIMEOUT, sender))
+        orphan.check()
+        ports.listener.timed_wait(ports.iox2.Duration.from_millis(BLOCK_SLICE_MS))
+        fresh = drain(ports, k, meter, refusals, sender)
+    return fresh
+
+
+def realtime(ports, cfg, agent, refusals, orphan, start_unix_ns):
+    """Steps `steps` steps against the wall clock; returns the pacing
+    (late_stages, max_lateness) and the meter of every input."""
+    node_id, steps, sample_every = cfg["id"], int(cfg["steps"]), int(cfg["sample_every"])
+    factor = float(cfg["realtime"])
+    step_wall = float(cfg["dt"]) / factor
+    # T0 on the monotonic clock: simulated t = 0 is wall time start_unix_ns.
+    t0 = time.monotonic() + (start_unix_ns - unix_ns()) * 1e-9
+    meters = [LinkMeter() for _ in cfg["inputs"]]
+    late_stages, max_lateness, exchanges = 0, 0.0, 0
+    ports.report(agent.sample(node_id, 0))
+    for n in range(steps):
+        if n % 256 == 0:
+            orphan.check()
+        for s in range(4):
+            lateness = time.monotonic() - (t0 + (n + STAGE_C[s]) * step_wall)
+            if lateness < 0.0:
+                time.sleep(-lateness)
+            else:
+                max_lateness = max(max_lateness, lateness)
+                if lateness > step_wall:  # more than one step late
+                    late_stages += 1
+            if exchanges_at(cfg["coupling"], n, s):
+                exchanges += 1
+                first = n == 0 and s == 0
+                ports.publish(state_msg(node_id, n, s, agent.exchanged(), unix_ns()),
+                              notify=first)
+                for k, meter in enumerate(meters):
+                    if first:
+                        fresh = first_states(ports, k, meter, refusals, cfg, orphan)
+                    else:
+                        fresh = drain(ports, k, meter, refusals, cfg["inputs"][k])
+                    if fresh is not None:
+                        agent.receive(k, fresh[0])
+                        meter.held_sent_ns = fresh[1]
+                    meter.age(factor)
+            agent.advance()
+        if (n + 1) % sample_every == 0 or n + 1 == steps:
+            ports.report(agent.sample(node_id, n + 1))
+    return (late_stages, max_lateness), meters, exchanges
+
+
+# ==========================================================================
+# § 6 The life of the node
+# ==========================================================================
+
+def link_stats(cfg, refusals, measured):
+    """LinkStats to report: every input in real time (measured), in
+    lockstep every input on which a message was refused."""
+    reports = []
+    if measured is not None:
+        meters, exchanges = measured
+        for k, (sender, m) in enumerate(zip(cfg["inputs"], meters)):
+            reports.append(telemetry(cfg["id"], LINK_STATS, LINK_STATS_BODY, sender, exchanges,
+                                     m.delivered, max(exchanges - m.delivered, 0),
+                                     refusals.count[k], m.evaluations, m.age_sum, m.age_max))
+    else:
+        for k, sender in enumerate(cfg["inputs"]):
+            if refusals.count[k]:
+                reports.append(telemetry(cfg["id"], LINK_STATS, LINK_STATS_BODY, sender, 0, 0,
+                                         0, refusals.count[k], 0, 0.0, 0.0))
+    return reports
+
+
+def step_all(ports, cfg, agent, orphan):
+    """Ready, Start, the steps, LinkStats and Done (§ 6.4-6.8)."""
+    node_id = cfg["id"]
+    ports.await_connections(cfg, orphan)
+    ports.report(telemetry(node_id, READY))
+    log(f"ready (id {node_id}, inputs {cfg['inputs']}, outputs {cfg['outputs']}, "
+        f"scheme {agent.scheme}, realtime {cfg['realtime']})")
+    command, start_ns = wait_command(ports, float(cfg["start_timeout"]), orphan)
+    if command != START:
+        raise NodeError("stopped before the end (at step 0)")
+    started_ns, t_start = unix_ns(), time.monotonic()
+    refusals = Refusals(cfg["inputs"])
+    try:
+        if cfg["realtime"] is None:
+            pacing, measured = lockstep(ports, cfg, agent, refusals, orphan), None
+        else:
+            pacing, meters, exchanges = realtime(ports, cfg, agent, refusals, orphan,
+                                                 start_ns or started_ns)
+            measured = (meters, exchanges)
+    except Exception as e:
+        # Tell the orchestrator whom we waited for, or that it was something
+        # else (best effort: we are failing anyway).
+        reason, sender = getattr(e, "failed", None) or (FAIL_OTHER, 0)
+        try:
+            ports.report(telemetry(node_id, FAILED, FAILED_BODY, reason, sender))
+        except Exception:
+            pass
+        raise
+    done_ns, wall = unix_ns(), time.monotonic() - t_start
+    for report in link_stats(cfg, refusals, measured):
+        ports.report(report)
+    rss = peak_rss_kb()
+    ports.report(telemetry(node_id, DONE, DONE_BODY, int(cfg["steps"]), agent.peak_torque,
+                           rss, started_ns, done_ns, pacing[0], pacing[1]))
+    log(f"done: {cfg['steps']} steps in {wall:.2f} s, peak torque {agent.peak_torque!r}, "
+        f"late stages {pacing[0]}, max lateness {pacing[1]:.6f} s, peak_rss_kb={rss}")
 
 
 def import_iceoryx2():
@@ -765,45 +1163,17 @@ def import_iceoryx2():
 
 def run(cfg):
     iox2 = import_iceoryx2()
-
     iox2.set_log_level(iox2.LogLevel.Error)  # else a "no config file" warning
-    node_id = cfg["id"]
     role = cfg["role"]
     try:
-        agent = ObserverlessAgent(role["model"], role["initial"], float(cfg["dt"]))
+        agent = Agent(role["model"], role["initial"], float(cfg["dt"]))
     except (KeyError, TypeError, ValueError) as e:
         raise NodeError(f"invalid node config: {e!r}", 2) from e
     orphan = Orphan()
     ports = Ports(iox2, cfg)
     try:
-        ports.await_connections(cfg, orphan)
-        ports.report(TELEMETRY.pack(PROTOCOL_VERSION, node_id, 0, READY, 0, *([0.0] * 28)))
-        log(f"ready (id {node_id}, inputs {cfg['inputs']}, outputs {cfg['outputs']})")
-        command, _ = wait_command(ports, float(cfg["start_timeout"]), orphan)
-        if command != START:
-            raise NodeError("stopped before the end (at step 0)")
-        log("started")
-        t0 = time.monotonic()
-        rejected, stats = lockstep(ports, cfg, agent, orphan)
-        wall = time.monotonic() - t0
-        # Link counters only for inputs that refused messages (the built-in
-        # agent also reports impaired links, which this agent refuses).
-        for k, count in enumerate(rejected):
-            if count:
-                fields = [0.0] * 28
-                fields[24] = float(count)  # s_hat[0] (r 0-8, w 9-11, r_hat 12-20, w_hat 21-23)
-                ports.report(TELEMETRY.pack(PROTOCOL_VERSION, node_id, cfg["inputs"][k],
-                                            LINK_STATS, 0, *fields))
-        done = [0.0] * 28
-        done[27] = agent.peak_torque
-        ports.report(TELEMETRY.pack(PROTOCOL_VERSION, node_id, int(cfg["steps"]), DONE, 0,
-                                    *done))
-        peak_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-        log(f"done: {cfg['steps']} steps in {wall:.2f} s, peak torque "
-            f"{agent.peak_torque!r}; waiting for inputs {stats['wait_s']:.2f} s "
-            f"({stats['yields']} yields, {stats['sleeps']} sleeps on the wake event); "
-            f"peak_rss_kb={peak_kb}")
-        command, _ = wait_command(ports, STOP_TIMEOUT, orphan)
+        step_all(ports, cfg, agent, orphan)
+        command, _ = wait_command(ports, STOP_TIMEOUT, orphan)  # § 6.9
         if command == START:
             raise NodeError("protocol violation: second Start")
     finally:
@@ -812,8 +1182,7 @@ def run(cfg):
 
 def main(argv):
     try:
-        cfg = read_config(config_path(argv))
-        run(cfg)
+        run(read_config(config_path(argv)))
     except NodeError as e:
         log(f"ERROR {e}")
         return e.code
