@@ -9,7 +9,7 @@
 //!   [`Series`], and `states.bin`), [`agent_summaries`], [`write_summary`].
 //! - [`summary`]: `summary.json` ([`Summary`]) and the end-of-run table.
 //! - [`states`]: `states.bin`, its byte layout, reader and CSV export.
-//! - [`plot`]: `errors.svg`.
+//! - [`plot`]: draws `errors.svg`.
 //! - [`staging`]: the atomic results directory (`.NAME.partial-PID`).
 
 pub mod layout;
