@@ -16,7 +16,7 @@ use attitude::agent::Agent;
 use attitude::network::Exchanged;
 use iceoryx2::node::Node;
 use iceoryx2::service::Service;
-use msgs::TelemetryMsg;
+use msgs::Telemetry;
 use msgs::config::{NodeConfig, Role};
 /// Runs any [`Stepper`] (your own agent model) behind the node loop: the
 /// way to write a plug-in agent in Rust (see `examples/saturated_agent/`).
@@ -29,7 +29,6 @@ use std::sync::atomic::AtomicBool;
 #[derive(Debug)]
 pub struct AgentNode {
     agent: Agent,
-    id: u32,
 }
 
 impl AgentNode {
@@ -38,7 +37,6 @@ impl AgentNode {
         match &cfg.role {
             Role::Agent { model, initial } => Ok(Self {
                 agent: Agent::new((**model).clone(), *initial, cfg.dt),
-                id: cfg.id,
             }),
             Role::Leader { .. } => Err(format!("node {} is configured as the leader", cfg.id)),
         }
@@ -62,8 +60,12 @@ impl Stepper for AgentNode {
         self.agent.advance();
     }
 
-    fn sample(&self, step: u64) -> TelemetryMsg {
-        TelemetryMsg::agent(self.id, step, self.agent.state(), self.agent.peak_torque())
+    fn sample(&self, step: u64) -> Telemetry {
+        Telemetry::Sample {
+            step,
+            state: *self.agent.state(),
+            peak_torque: self.agent.peak_torque(),
+        }
     }
 
     fn peak_torque(&self) -> f64 {

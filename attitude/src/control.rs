@@ -46,7 +46,7 @@ pub fn tracking_error(
     }
 }
 
-/// The skew-symmetric matrix `Σᵢ`, as corrected (erratum 1 of NOTES.md).
+/// The skew-symmetric matrix `Σᵢ`, as corrected (erratum 1 of `docs/paper.md`).
 ///
 /// # Equation
 /// ```text
@@ -63,7 +63,7 @@ pub fn sigma_i(inertia: &Inertia, e: &TrackingError) -> Matrix3<f64> {
     hat(&(j * e.w_bar)) + hat(&(j * e.v)) - hv * j - j * hv
 }
 
-/// The feed-forward term `Γᵢ`, as corrected (erratum 1 of NOTES.md).
+/// The feed-forward term `Γᵢ`, as corrected (erratum 1 of `docs/paper.md`).
 ///
 /// # Equation
 /// ```text

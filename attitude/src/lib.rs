@@ -1,8 +1,9 @@
 //! Pure model of leader-follower attitude synchronisation of rigid bodies on
 //! SO(3), after "Leader-follower attitude synchronization of rigid-body
 //! systems on SO(3)" (equation labels in the docs are that paper's
-//! `\label{}` names; see `shared/paper/NOTES.md` for the plain notation and
-//! the errata this crate implements).
+//! `\label{}` names; see `docs/paper.md` for the plain notation, a table of
+//! the labels and where each is implemented, and the errata this crate
+//! implements). `PROTOCOL.md` § 10 gives the arithmetic to the bit.
 //!
 //! No clock, no I/O, no transport: time and every input are parameters.
 //!

@@ -16,11 +16,12 @@
 //! At every slot the receiver holds the freshest delivered message (largest
 //! stamp); a late, older message never replaces a newer one, and a lost
 //! message means the receiver keeps what it had. Before the first delivery
-//! the receiver holds the sender's state at t = 0 (the history of a delayed
-//! system before t = 0 is its initial state). With a constant delay of k
-//! steps the receiver uses at stage s of step n exactly the sender's stage-s
-//! state of step n − k: RK4 applied to the delay equation by the method of
-//! steps.
+//! the receiver holds the first valid message it was offered, normally the
+//! sender's state at t = 0 (the history of a delayed system before t = 0 is
+//! its initial state). With a constant delay of k steps the receiver uses
+//! at stage s of step n exactly the sender's stage-s state of step n − k:
+//! RK4 applied to the delay equation by the method of steps.
+//! `PROTOCOL.md` § 10.9 states all this for plug-ins.
 //!
 //! A link without impairments is not filtered at all, so an unimpaired run
 //! stays byte-identical to the plain engine.
@@ -120,7 +121,8 @@ pub struct LinkStats {
     /// Stages evaluated.
     pub evaluations: u64,
     /// Messages the receiver refused as invalid (non-finite numbers, or a
-    /// matrix that is not a rotation); counted by the process runtime.
+    /// matrix that is not a rotation); counted by the receiving agent
+    /// (`Agent::receive_neighbour` / `receive_leader`) in every engine.
     #[serde(default)]
     pub rejected: u64,
 }

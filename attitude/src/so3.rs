@@ -127,8 +127,9 @@ pub fn abs_i(r: &Matrix3<f64>) -> f64 {
 /// u̇ = ω + ½ u × ω + (1/θ²)(1 − (θ/2) cot(θ/2)) u × (u × ω),   θ = ‖u‖
 /// ```
 /// This is `dexp⁻¹_{−u}(ω)` in Munthe-Kaas' notation, the form RKMK needs
-/// for left-invariant fields. Series for small θ: the coefficient is
-/// `1/12 + θ²/720 + θ⁴/30240`.
+/// for left-invariant fields. Series for small θ (θ² < 1e-6): the
+/// coefficient is `1/12 + θ²/720 + θ⁴/30240`. `PROTOCOL.md` § 10.2 gives
+/// the order of every operation.
 #[must_use]
 pub fn dexp_inv(u: &Vector3<f64>, w: &Vector3<f64>) -> Vector3<f64> {
     let t2 = u.norm_squared();

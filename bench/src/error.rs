@@ -52,6 +52,9 @@ pub enum BenchError {
     /// A scenario could not be loaded.
     #[error(transparent)]
     Scenario(#[from] attsync::scenario::ScenarioError),
+    /// iceoryx2 refused to create the node or its namespace.
+    #[error(transparent)]
+    Iox(#[from] msgs::iox::IoxError),
     /// iceoryx2 refused to open a port or to send or receive.
     #[error("{what}: {detail}")]
     Iceoryx {

@@ -6,9 +6,9 @@
 
 use crate::error::{BenchError, Result};
 use crate::procs;
-use attsync::results::RunLayout;
+use attsync::results::summary::NodeSummary;
+use attsync::results::{RunLayout, Summary};
 use msgs::config::WaitStrategy;
-use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
@@ -60,38 +60,6 @@ pub struct AttsyncRun {
     pub agent_rss_kb: Vec<u64>,
     /// Process engine: the leader's `peak_rss_kb`.
     pub leader_rss_kb: Option<u64>,
-}
-
-/// The part of `summary.json` the benchmark reads.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-pub struct SummaryFigures {
-    /// Whether the run reached its horizon.
-    pub complete: bool,
-    /// Why not, if not.
-    #[serde(default)]
-    pub incomplete_reason: Option<String>,
-    /// Steps done.
-    pub steps: u64,
-    /// The engine's run time, s.
-    pub wall_seconds: f64,
-    /// Process engine: one entry per node.
-    #[serde(default)]
-    pub nodes: Vec<NodeFigures>,
-}
-
-/// A node of `summary.json` `nodes` (process engine).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-pub struct NodeFigures {
-    /// Node id (0 = the leader).
-    pub id: u32,
-    /// `leader`, `agent-<id>`.
-    pub name: String,
-    /// The node's peak resident set size (VmHWM) at `Done`, kB.
-    pub peak_rss_kb: u64,
-    /// Wall time the node began stepping (after `Start`), ns since the Unix epoch.
-    pub started_unix_ns: u64,
-    /// Wall time it finished its last step, ns since the Unix epoch.
-    pub done_unix_ns: u64,
 }
 
 /// Runs `attsync run SCENARIO --engine … --out OUT --quiet [--set …]`.
@@ -162,8 +130,8 @@ pub fn attsync(
     Ok(r)
 }
 
-/// Reads the figures of a `summary.json`.
-pub fn read_summary(path: &Path) -> Result<SummaryFigures> {
+/// Reads a `summary.json`.
+pub fn read_summary(path: &Path) -> Result<Summary> {
     let text = std::fs::read_to_string(path).map_err(BenchError::io(path))?;
     serde_json::from_str(&text).map_err(|e| BenchError::Results {
         path: path.to_owned(),
@@ -174,7 +142,7 @@ pub fn read_summary(path: &Path) -> Result<SummaryFigures> {
 /// The stepping interval of a process run: first node's start to the last
 /// node's end, s (`None` without nodes).
 #[must_use]
-pub fn lockstep(nodes: &[NodeFigures]) -> Option<f64> {
+pub fn lockstep(nodes: &[NodeSummary]) -> Option<f64> {
     let first = nodes.iter().map(|n| n.started_unix_ns).min()?;
     let last = nodes.iter().map(|n| n.done_unix_ns).max()?;
     Some(last.saturating_sub(first) as f64 * 1e-9)
@@ -186,21 +154,21 @@ mod tests {
 
     #[test]
     fn figures_from_summary_json() {
-        let text = r#"{"complete": true, "incomplete_reason": null, "steps": 40000,
-            "wall_seconds": 3.9, "engine": "processes",
+        let text = r#"{"attsync_version": "0", "scenario": "s", "engine": "processes",
+            "complete": true, "incomplete_reason": null, "dt": 0.001, "duration": 40.0,
+            "t_end": 40.0, "steps": 40000, "wall_seconds": 3.9, "max_final_att_err": 0.0,
+            "agents": [], "links": [],
             "nodes": [
               {"id": 0, "name": "leader", "peak_rss_kb": 7000,
                "started_unix_ns": 1764600000000000000, "done_unix_ns": 1764600001900000000},
               {"id": 1, "name": "agent-1", "peak_rss_kb": 8100,
                "started_unix_ns": 1764600000100000000, "done_unix_ns": 1764600002000000000}
             ]}"#;
-        let s: SummaryFigures = serde_json::from_str(text).unwrap();
+        let s: Summary = serde_json::from_str(text).unwrap();
         assert_eq!(s.nodes.len(), 2);
         assert_eq!(s.nodes[1].peak_rss_kb, 8100);
         let l = lockstep(&s.nodes).unwrap();
         assert!((l - 2.0).abs() < 1e-9, "{l}");
-        let inproc: SummaryFigures =
-            serde_json::from_str(r#"{"complete": true, "steps": 1, "wall_seconds": 0.1}"#).unwrap();
-        assert_eq!(lockstep(&inproc.nodes), None);
+        assert_eq!(lockstep(&[]), None);
     }
 }

@@ -332,21 +332,11 @@ impl RingNode {
         };
         let barrier = Duration::from_secs_f64(self.barrier_timeout);
 
-        set_log_level(LogLevel::Error);
-        let cfg =
-            msgs::namespace::config(run, &self.root.join("iox")).map_err(BenchError::Usage)?;
-        let name = format!("ring_{id}");
-        let node = NodeBuilder::new()
-            .name(
-                &name
-                    .as_str()
-                    .try_into()
-                    .map_err(BenchError::iox("node name"))?,
-            )
-            .config(&cfg)
-            .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<ipc::Service>()
-            .map_err(BenchError::iox("iceoryx2 node"))?;
+        let node = msgs::iox::create_node::<ipc::Service>(
+            run,
+            &self.root.join("iox"),
+            &format!("ring_{id}"),
+        )?;
         let stage_timeout = Duration::from_secs_f64(self.stage_timeout);
         let ports = Ports::open(&node, run, id, (&inputs, &outputs), &limits, stage_timeout)?;
 
@@ -379,7 +369,7 @@ impl RingNode {
             start_unix,
             end_unix,
             elapsed,
-            peak_rss_kb: attsync_agent::runtime::peak_rss_kb(),
+            peak_rss_kb: msgs::telemetry::peak_rss_kb(),
         })
     }
 

@@ -7,7 +7,7 @@ use attitude::reference::Leader;
 use attsync_agent::{NodeError, Stepper};
 use iceoryx2::node::Node;
 use iceoryx2::service::Service;
-use msgs::TelemetryMsg;
+use msgs::Telemetry;
 use msgs::config::{NodeConfig, Role};
 use std::sync::atomic::AtomicBool;
 
@@ -36,8 +36,11 @@ impl Stepper for LeaderNode {
         self.0.advance();
     }
 
-    fn sample(&self, step: u64) -> TelemetryMsg {
-        TelemetryMsg::leader(step, self.0.state())
+    fn sample(&self, step: u64) -> Telemetry {
+        Telemetry::LeaderSample {
+            step,
+            state: *self.0.state(),
+        }
     }
 
     fn peak_torque(&self) -> f64 {

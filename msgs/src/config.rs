@@ -87,25 +87,68 @@ pub struct NodeConfig {
 
 impl NodeConfig {
     /// Reads a config file.
-    pub fn read(path: &Path) -> Result<Self, String> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-        let cfg: Self = serde_json::from_str(&text)
-            .map_err(|e| format!("{}: invalid node config: {e}", path.display()))?;
+    pub fn read(path: &Path) -> Result<Self, ConfigError> {
+        let file = path.to_path_buf();
+        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::Read {
+            file: file.clone(),
+            cause: e.to_string(),
+        })?;
+        let cfg: Self = serde_json::from_str(&text).map_err(|e| ConfigError::Invalid {
+            file: file.clone(),
+            cause: e.to_string(),
+        })?;
         if cfg.protocol_version != crate::PROTOCOL_VERSION {
-            return Err(format!(
-                "{}: protocol version {} but this program speaks {}",
-                path.display(),
-                cfg.protocol_version,
-                crate::PROTOCOL_VERSION
-            ));
+            return Err(ConfigError::Version {
+                file,
+                theirs: cfg.protocol_version,
+            });
         }
         Ok(cfg)
     }
 
     /// Writes a config file.
-    pub fn write(&self, path: &Path) -> Result<(), String> {
+    pub fn write(&self, path: &Path) -> Result<(), ConfigError> {
         let text = serde_json::to_string_pretty(self).expect("a config serialises");
-        std::fs::write(path, text).map_err(|e| format!("{}: cannot write: {e}", path.display()))
+        std::fs::write(path, text).map_err(|e| ConfigError::Write {
+            file: path.to_path_buf(),
+            cause: e.to_string(),
+        })
     }
+}
+
+/// A node configuration file that cannot be read or written.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ConfigError {
+    /// The file cannot be read.
+    #[error("{}: cannot read: {cause}", file.display())]
+    Read {
+        /// The file.
+        file: std::path::PathBuf,
+        /// The operating system's reason.
+        cause: String,
+    },
+    /// The file is not a valid configuration.
+    #[error("{}: invalid node config: {cause}", file.display())]
+    Invalid {
+        /// The file.
+        file: std::path::PathBuf,
+        /// What is wrong.
+        cause: String,
+    },
+    /// The configuration is for another protocol version.
+    #[error("{}: protocol version {theirs} but this program speaks {}", file.display(), crate::PROTOCOL_VERSION)]
+    Version {
+        /// The file.
+        file: std::path::PathBuf,
+        /// Its `protocol_version`.
+        theirs: u32,
+    },
+    /// The file cannot be written.
+    #[error("{}: cannot write: {cause}", file.display())]
+    Write {
+        /// The file.
+        file: std::path::PathBuf,
+        /// The operating system's reason.
+        cause: String,
+    },
 }

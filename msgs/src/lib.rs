@@ -7,20 +7,27 @@
 //! can match them. Matrices are **row-major** `[f64; 9]`.
 //!
 //! # Layout
-//! - [`payload`]: [`StateMsg`], [`TelemetryMsg`], [`ControlMsg`], [`PROTOCOL_VERSION`].
+//! - [`payload`]: [`StateMsg`], [`ControlMsg`], [`PROTOCOL_VERSION`].
+//! - [`telemetry`]: [`Telemetry`] (what a node reports) and its wire form [`TelemetryMsg`], encoded and decoded side by side.
 //! - [`config`]: the JSON configuration each node process receives.
 //! - [`names`]: service names under `attsync/<run>/…`.
 //! - [`open`]: the openers, with limits derived from the topology ([`Limits`]).
 //! - [`namespace`]: the per-run iceoryx2 configuration (file prefix, root path).
+//! - [`iox`]: [`IoxError`](iox::IoxError) for any failed iceoryx2 call; [`create_node`](iox::create_node) in a run's namespace.
 
 pub mod config;
+pub mod iox;
 pub mod names;
 pub mod namespace;
 pub mod open;
 pub mod payload;
+pub mod telemetry;
 
 pub use open::Limits;
 pub use payload::{
-    ControlCommand, ControlMsg, Invalid, PROTOCOL_VERSION, ROTATION_TOLERANCE, StateMsg,
-    TelemetryKind, TelemetryMsg, unix_ns_now,
+    ControlCommand, ControlMsg, Invalid, PROTOCOL_VERSION, ROTATION_TOLERANCE, StateMsg, from_rows,
+    to_rows, unix_ns_now,
+};
+pub use telemetry::{
+    Done, FailReason, Pacing, Telemetry, TelemetryError, TelemetryKind, TelemetryMsg,
 };

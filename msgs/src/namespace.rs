@@ -3,6 +3,7 @@
 //! `<base>/<run>/`, so two runs, or parallel tests, never meet, and a run's
 //! leftovers can be removed by name.
 
+use crate::iox::{IoxError, iox};
 use iceoryx2::config::Config;
 use iceoryx2::prelude::{FileName, Path, SemanticString};
 
@@ -14,17 +15,15 @@ pub fn prefix(run: &str) -> String {
 
 /// The iceoryx2 configuration of a run: prefix [`prefix`], root path `root`
 /// (a directory that belongs to the run, with a trailing `/`).
-pub fn config(run: &str, root: &std::path::Path) -> Result<Config, String> {
+pub fn config(run: &str, root: &std::path::Path) -> Result<Config, IoxError> {
     let mut cfg = Config::default();
-    cfg.global.prefix = FileName::new(prefix(run).as_bytes())
-        .map_err(|e| format!("run id {run:?} makes an invalid iceoryx2 prefix: {e:?}"))?;
+    cfg.global.prefix =
+        FileName::new(prefix(run).as_bytes()).map_err(iox("file prefix from the run id"))?;
     let mut root = root.to_string_lossy().into_owned();
     if !root.ends_with('/') {
         root.push('/');
     }
-    cfg.global.set_root_path(
-        &Path::new(root.as_bytes())
-            .map_err(|e| format!("invalid iceoryx2 root path {root:?}: {e:?}"))?,
-    );
+    cfg.global
+        .set_root_path(&Path::new(root.as_bytes()).map_err(iox("root path"))?);
     Ok(cfg)
 }

@@ -4,7 +4,8 @@
 //! the same [`Limits`].
 
 use crate::names;
-use crate::payload::{ControlMsg, StateMsg, TelemetryMsg};
+use crate::payload::{ControlMsg, StateMsg};
+use crate::telemetry::TelemetryMsg;
 use attitude::network::Network;
 use iceoryx2::node::Node;
 use iceoryx2::prelude::ServiceName;

@@ -2,14 +2,13 @@
 //! implicit padding: every struct is laid out so that offsets are multiples
 //! of 8 where an `f64` or `u64` starts). PROTOCOL.md lists the offsets.
 
-use attitude::network::{AgentState, Exchanged};
-use attitude::reference::LeaderState;
+use attitude::network::Exchanged;
 use iceoryx2::prelude::ZeroCopySend;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layouts and the stepping rules. A receiver refuses
 /// a message whose `version` differs.
-pub const PROTOCOL_VERSION: u32 = 2;
+pub const PROTOCOL_VERSION: u32 = 3;
 
 /// Row-major copy of a matrix.
 #[must_use]
@@ -109,170 +108,6 @@ pub fn unix_ns_now() -> u64 {
         .map_or(0, |d| d.as_nanos() as u64)
 }
 
-/// What a telemetry message reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(u32)]
-pub enum TelemetryKind {
-    /// The node has connected all its ports and waits for `Start`.
-    Ready = 1,
-    /// The node's state at an output sample (`step` is the step index).
-    Sample = 2,
-    /// The node has done its last step; `peak_torque` is final. In
-    /// real-time mode `w` = [stages started late, largest lateness (wall s), 0].
-    Done = 3,
-    /// Counters of one incoming link, sent before `Done`: `step` = the
-    /// sender's id, `w` = [sent, delivered, lost], `w_hat` = [sum of the age
-    /// of information over evaluated stages (s), largest age (s), stages
-    /// evaluated], `s_hat[0]` = messages rejected as invalid.
-    LinkStats = 4,
-    /// The node gives up while stepping, just before it exits: `step` = the
-    /// id of the input whose state did not arrive in time, or `u64::MAX`
-    /// for any other reason (e.g. a receiver that stopped reading).
-    Failed = 5,
-}
-
-impl TelemetryKind {
-    /// Decodes the wire value.
-    #[must_use]
-    pub fn from_u32(v: u32) -> Option<Self> {
-        match v {
-            1 => Some(Self::Ready),
-            2 => Some(Self::Sample),
-            3 => Some(Self::Done),
-            4 => Some(Self::LinkStats),
-            5 => Some(Self::Failed),
-            _ => None,
-        }
-    }
-}
-
-/// A node's report to the orchestrator. Service
-/// `attsync/<run>/node/<id>/telemetry`.
-///
-/// For an agent: `r, w` the body, `r_hat, w_hat, s_hat` the observer. For
-/// the leader (sender 0): `r = R₀`, `w = ω₀`, `s_hat = σ₀`, the rest zero.
-#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
-#[repr(C)]
-#[type_name("attsync::TelemetryMsg")]
-pub struct TelemetryMsg {
-    /// [`PROTOCOL_VERSION`].
-    pub version: u32,
-    /// Sender's node id.
-    pub sender: u32,
-    /// Step index of the sample.
-    pub step: u64,
-    /// [`TelemetryKind`] as `u32`.
-    pub kind: u32,
-    /// Reserved, 0.
-    pub reserved: u32,
-    /// `Rᵢ` (or `R₀`), row-major.
-    pub r: [f64; 9],
-    /// `ωᵢ` (or `ω₀`).
-    pub w: [f64; 3],
-    /// `R̂ᵢ`, row-major.
-    pub r_hat: [f64; 9],
-    /// `ω̂ᵢ`.
-    pub w_hat: [f64; 3],
-    /// `σ̂ᵢ` (or `σ₀`).
-    pub s_hat: [f64; 3],
-    /// Largest ‖τᵢ‖ so far, N·m (0 for the leader).
-    pub peak_torque: f64,
-}
-
-impl TelemetryMsg {
-    /// A message with no state (for `Ready`, or `Done` carrying the peak torque).
-    #[must_use]
-    pub fn bare(sender: u32, step: u64, kind: TelemetryKind, peak_torque: f64) -> Self {
-        Self {
-            version: PROTOCOL_VERSION,
-            sender,
-            step,
-            kind: kind as u32,
-            reserved: 0,
-            r: [0.0; 9],
-            w: [0.0; 3],
-            r_hat: [0.0; 9],
-            w_hat: [0.0; 3],
-            s_hat: [0.0; 3],
-            peak_torque,
-        }
-    }
-
-    /// An agent's sample.
-    #[must_use]
-    pub fn agent(sender: u32, step: u64, x: &AgentState, peak_torque: f64) -> Self {
-        Self {
-            r: to_rows(&x.r),
-            w: x.w.into(),
-            r_hat: to_rows(&x.r_hat),
-            w_hat: x.w_hat.into(),
-            s_hat: x.s_hat.into(),
-            ..Self::bare(sender, step, TelemetryKind::Sample, peak_torque)
-        }
-    }
-
-    /// The leader's sample.
-    #[must_use]
-    pub fn leader(step: u64, x: &LeaderState) -> Self {
-        Self {
-            r: to_rows(&x.r0),
-            w: x.w0.into(),
-            s_hat: x.s0.into(),
-            ..Self::bare(0, step, TelemetryKind::Sample, 0.0)
-        }
-    }
-
-    /// Counters of the link `from` → `sender`.
-    #[must_use]
-    pub fn link_stats(sender: u32, from: u32, s: &attitude::link::LinkStats) -> Self {
-        Self {
-            w: [s.sent as f64, s.delivered as f64, s.lost as f64],
-            w_hat: [s.age_sum, s.age_max, s.evaluations as f64],
-            s_hat: [s.rejected as f64, 0.0, 0.0],
-            ..Self::bare(sender, u64::from(from), TelemetryKind::LinkStats, 0.0)
-        }
-    }
-
-    /// Decodes link counters: (from, stats).
-    #[must_use]
-    pub fn decode_link_stats(&self) -> (u32, attitude::link::LinkStats) {
-        (
-            self.step as u32,
-            attitude::link::LinkStats {
-                sent: self.w[0] as u64,
-                delivered: self.w[1] as u64,
-                lost: self.w[2] as u64,
-                age_sum: self.w_hat[0],
-                age_max: self.w_hat[1],
-                evaluations: self.w_hat[2] as u64,
-                rejected: self.s_hat[0] as u64,
-            },
-        )
-    }
-
-    /// Decodes an agent's state.
-    #[must_use]
-    pub fn agent_state(&self) -> AgentState {
-        AgentState {
-            r: from_rows(&self.r),
-            w: Vector3::from(self.w),
-            r_hat: from_rows(&self.r_hat),
-            w_hat: Vector3::from(self.w_hat),
-            s_hat: Vector3::from(self.s_hat),
-        }
-    }
-
-    /// Decodes the leader's state.
-    #[must_use]
-    pub fn leader_state(&self) -> LeaderState {
-        LeaderState {
-            r0: from_rows(&self.r),
-            w0: Vector3::from(self.w),
-            s0: Vector3::from(self.s_hat),
-        }
-    }
-}
-
 /// Orchestrator commands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[repr(u32)]
@@ -344,10 +179,6 @@ mod tests {
         assert_eq!(offset_of!(StateMsg, w), 104);
         assert_eq!(offset_of!(StateMsg, s), 128);
         assert_eq!(size_of::<StateMsg>(), 152);
-        assert_eq!(offset_of!(TelemetryMsg, r), 24);
-        assert_eq!(offset_of!(TelemetryMsg, r_hat), 120);
-        assert_eq!(offset_of!(TelemetryMsg, peak_torque), 240);
-        assert_eq!(size_of::<TelemetryMsg>(), 248);
         assert_eq!(offset_of!(ControlMsg, start_unix_ns), 8);
         assert_eq!(size_of::<ControlMsg>(), 16);
         assert_eq!(align_of::<StateMsg>(), 8);

@@ -107,7 +107,7 @@ pub fn run(
         bar.set_position(snap.step);
         true
     };
-    let (peaks, steps, failure, links, pacing) = match opts.engine {
+    let (peaks, steps, failure, links, pacing, nodes) = match opts.engine {
         Engine::InProcess => {
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
@@ -136,6 +136,7 @@ pub fn run(
                 interrupted.then(|| "interrupted".to_string()),
                 links,
                 Vec::new(),
+                Vec::new(),
             )
         }
         Engine::Processes => {
@@ -146,6 +147,7 @@ pub fn run(
                 out.failure,
                 out.links,
                 out.pacing,
+                out.nodes,
             )
         }
     };
@@ -200,6 +202,16 @@ pub fn run(
             })
             .collect(),
         realtime: opts.processes.realtime,
+        nodes: nodes
+            .into_iter()
+            .map(|(name, id, d)| results::summary::NodeSummary {
+                id,
+                name,
+                peak_rss_kb: d.peak_rss_kb,
+                started_unix_ns: d.started_unix_ns,
+                done_unix_ns: d.done_unix_ns,
+            })
+            .collect(),
     };
     let svg = dir.join("errors.svg");
     plot::draw(

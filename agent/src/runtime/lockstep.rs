@@ -7,11 +7,11 @@ use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_o
 use crate::wait::Waiter;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
-use msgs::{StateMsg, TelemetryKind, TelemetryMsg};
+use msgs::{Pacing, StateMsg};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-/// Steps `cfg.steps` steps in lockstep; returns the `Done` report.
+/// Steps `cfg.steps` steps in lockstep (always on time: no pacing to report).
 pub(crate) fn run<S: Service, N: Stepper>(
     ports: &Ports<S>,
     cfg: &NodeConfig,
@@ -19,11 +19,11 @@ pub(crate) fn run<S: Service, N: Stepper>(
     inputs: &mut Inputs,
     shutdown: &AtomicBool,
     orphan: &Orphan,
-) -> Result<TelemetryMsg, NodeError> {
+) -> Result<Pacing, NodeError> {
     let stage_timeout = Duration::from_secs_f64(cfg.stage_timeout);
     let mut waiter = Waiter::new(cfg.wait);
     let notify = waiter.receivers_may_block();
-    ports.report(stepper.sample(0))?;
+    ports.report(cfg.id, &stepper.sample(0))?;
     for n in 0..cfg.steps {
         before_step(n, shutdown, orphan)?;
         for s in 0..4u32 {
@@ -75,10 +75,5 @@ pub(crate) fn run<S: Service, N: Stepper>(
         }
         after_step(ports, cfg, stepper, n + 1)?;
     }
-    Ok(TelemetryMsg::bare(
-        cfg.id,
-        cfg.steps,
-        TelemetryKind::Done,
-        stepper.peak_torque(),
-    ))
+    Ok(Pacing::default())
 }

@@ -23,7 +23,11 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::open::OpenError;
-use msgs::{ControlCommand, ControlMsg, PROTOCOL_VERSION, StateMsg, TelemetryKind, TelemetryMsg};
+use msgs::telemetry::peak_rss_kb;
+use msgs::{
+    ControlCommand, ControlMsg, Done, FailReason, PROTOCOL_VERSION, StateMsg, Telemetry,
+    unix_ns_now,
+};
 use ports::Ports;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -44,9 +48,10 @@ pub trait Stepper {
     fn receive(&mut self, k: usize, x: Exchanged);
     /// Evaluates the current stage and moves on.
     fn advance(&mut self);
-    /// Telemetry sample of the state at the start of the current step
-    /// (`TelemetryMsg::agent` for an agent).
-    fn sample(&self, step: u64) -> TelemetryMsg;
+    /// Telemetry sample of the state at the start of the current step, which
+    /// is step `step` ([`Telemetry::Sample`] for an agent,
+    /// [`Telemetry::LeaderSample`] for the leader).
+    fn sample(&self, step: u64) -> Telemetry;
     /// Largest torque norm applied so far, taken at stage 0 of each step
     /// (as the built-in agent does), N·m.
     fn peak_torque(&self) -> f64;
@@ -121,13 +126,14 @@ pub fn run<S: Service, N: Stepper>(
     let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
     let ports = Ports::open(node, cfg)?;
     ports.await_connections(cfg)?;
-    ports.report(TelemetryMsg::bare(cfg.id, 0, TelemetryKind::Ready, 0.0))?;
+    ports.report(cfg.id, &Telemetry::Ready)?;
     info!(id = cfg.id, inputs = ?cfg.inputs, outputs = ?cfg.outputs, "ready");
     let start = match wait_command(&ports.control, start_timeout, shutdown, &orphan)? {
         Some((ControlCommand::Start, start)) => start,
         _ => return Err(NodeError::Stopped(0)),
     };
     info!(realtime = ?cfg.realtime, "started");
+    let started_unix_ns = unix_ns_now();
 
     let mut inputs = Inputs::new(cfg);
     let stepped = match cfg.realtime {
@@ -142,29 +148,30 @@ pub fn run<S: Service, N: Stepper>(
             &orphan,
         ),
     };
-    let done = match stepped {
-        Ok(done) => done,
+    let pacing = match stepped {
+        Ok(pacing) => pacing,
         Err(e) => {
             // Tell the orchestrator whom we waited for (or that it was
             // something else), so that it can name the node that hangs
             // (best effort: we are failing anyway).
-            let (whom, why) = match e {
-                NodeError::InputTimeout { from, .. } => (u64::from(from), FAILED_TIMEOUT),
-                NodeError::BadInput { from, .. } => (u64::from(from), FAILED_BAD_INPUT),
-                _ => (u64::MAX, 0.0),
-            };
-            let _ = ports.report(TelemetryMsg {
-                w: [why, 0.0, 0.0],
-                ..TelemetryMsg::bare(cfg.id, whom, TelemetryKind::Failed, 0.0)
-            });
+            let _ = ports.report(cfg.id, &Telemetry::Failed(failure(&e)));
             return Err(e);
         }
     };
-    for (from, st) in inputs.stats(cfg, stepper.link_stats()) {
-        ports.report(TelemetryMsg::link_stats(cfg.id, from, &st))?;
+    let done_unix_ns = unix_ns_now();
+    for (from, stats) in inputs.stats(cfg, stepper.link_stats()) {
+        ports.report(cfg.id, &Telemetry::LinkStats { from, stats })?;
     }
-    ports.report(done)?;
-    info!(steps = cfg.steps, peak_rss_kb = peak_rss_kb(), "done");
+    let done = Done {
+        steps: cfg.steps,
+        peak_torque: stepper.peak_torque(),
+        peak_rss_kb: peak_rss_kb(),
+        started_unix_ns,
+        done_unix_ns,
+        pacing,
+    };
+    ports.report(cfg.id, &Telemetry::Done(done))?;
+    info!(steps = cfg.steps, peak_rss_kb = done.peak_rss_kb, "done");
     // Other nodes may still be stepping: wait for Stop as long as the
     // orchestrator lives (bounded by STOP_TIMEOUT all the same).
     match wait_command(&ports.control, STOP_TIMEOUT, shutdown, &orphan)? {
@@ -246,27 +253,17 @@ impl Inputs {
     }
 }
 
-/// `Failed` reason (`w[0]`): an input's state did not arrive in time.
-pub const FAILED_TIMEOUT: f64 = 1.0;
-/// `Failed` reason (`w[0]`): an input broke the protocol.
-pub const FAILED_BAD_INPUT: f64 = 2.0;
+/// The `Failed` report of a node that gives up with `e` while stepping.
+fn failure(e: &NodeError) -> FailReason {
+    match *e {
+        NodeError::InputTimeout { from, .. } => FailReason::InputTimeout { from },
+        NodeError::BadInput { from, .. } => FailReason::BadInput { from },
+        _ => FailReason::Other,
+    }
+}
 
 /// Longest wait for `Stop` after the last step.
 const STOP_TIMEOUT: Duration = Duration::from_secs(600);
-
-/// Peak resident set size of this process (VmHWM), kB; 0 if unknown.
-#[must_use]
-pub fn peak_rss_kb() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|v| v.parse().ok())
-        })
-        .unwrap_or(0)
-}
 
 /// Detects that the process that started us (the orchestrator) is gone, so
 /// that a node never outlives its run.
@@ -309,7 +306,7 @@ pub(crate) fn after_step<S: Service, N: Stepper>(
     done: u64,
 ) -> Result<(), NodeError> {
     if done % cfg.sample_every == 0 || done == cfg.steps {
-        ports.report(stepper.sample(done))?;
+        ports.report(cfg.id, &stepper.sample(done))?;
     }
     Ok(())
 }

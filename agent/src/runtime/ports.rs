@@ -11,7 +11,7 @@ use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSub;
 use msgs::config::NodeConfig;
 use msgs::open;
-use msgs::{ControlMsg, StateMsg, TelemetryMsg};
+use msgs::{ControlMsg, StateMsg, Telemetry, TelemetryMsg};
 use std::time::{Duration, Instant};
 
 /// A node's ports.
@@ -148,9 +148,11 @@ impl<S: Service> Ports<S> {
         }
     }
 
-    /// Sends a telemetry message and wakes the orchestrator.
-    pub fn report(&self, m: TelemetryMsg) -> Result<(), NodeError> {
-        self.tele_pub.send_copy(m).map_err(port("telemetry send"))?;
+    /// Sends a telemetry report of node `id` and wakes the orchestrator.
+    pub fn report(&self, id: u32, t: &Telemetry) -> Result<(), NodeError> {
+        self.tele_pub
+            .send_copy(TelemetryMsg::encode(id, t))
+            .map_err(port("telemetry send"))?;
         let _ = self.orch_notifier.notify();
         Ok(())
     }

@@ -21,7 +21,7 @@ use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_o
 use attitude::link::LinkStats;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
-use msgs::{StateMsg, TelemetryKind, TelemetryMsg, unix_ns_now};
+use msgs::{Pacing, StateMsg, unix_ns_now};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
@@ -62,7 +62,7 @@ impl Clock {
     }
 }
 
-/// Steps `cfg.steps` steps paced by `clock`; returns the `Done` report.
+/// Steps `cfg.steps` steps paced by `clock`; returns how well it kept to it.
 pub(crate) fn run<S: Service, N: Stepper>(
     ports: &Ports<S>,
     cfg: &NodeConfig,
@@ -71,13 +71,13 @@ pub(crate) fn run<S: Service, N: Stepper>(
     clock: Clock,
     shutdown: &AtomicBool,
     orphan: &Orphan,
-) -> Result<TelemetryMsg, NodeError> {
+) -> Result<Pacing, NodeError> {
     let k_in = ports.inputs.len();
     let mut newest: Vec<Option<(u64, u32)>> = vec![None; k_in];
     let mut held_sent: Vec<Option<u64>> = vec![None; k_in];
     let (mut late_stages, mut max_late) = (0u64, 0.0f64);
     let mut exchanges = 0u64;
-    ports.report(stepper.sample(0))?;
+    ports.report(cfg.id, &stepper.sample(0))?;
     for n in 0..cfg.steps {
         before_step(n, shutdown, orphan)?;
         for s in 0..4u32 {
@@ -157,13 +157,8 @@ pub(crate) fn run<S: Service, N: Stepper>(
         };
     }
     tracing::info!(late_stages, max_late_s = max_late, "real-time pacing");
-    Ok(TelemetryMsg {
-        w: [late_stages as f64, max_late, 0.0],
-        ..TelemetryMsg::bare(
-            cfg.id,
-            cfg.steps,
-            TelemetryKind::Done,
-            stepper.peak_torque(),
-        )
+    Ok(Pacing {
+        late_stages,
+        max_lateness: max_late,
     })
 }

@@ -8,7 +8,7 @@ use attitude::integrate::{LieState, Rkmk4};
 use attitude::network::{AgentModel, AgentState, Exchanged, Scheme};
 use attitude::observer::LeaderInput;
 use attsync_agent::Stepper;
-use msgs::TelemetryMsg;
+use msgs::Telemetry;
 use msgs::config::{NodeConfig, Role};
 use nalgebra::{Matrix3, Vector3};
 
@@ -23,7 +23,6 @@ use nalgebra::{Matrix3, Vector3};
 /// leader if it hears it (the order of [`NodeConfig::inputs`]).
 #[derive(Debug, Clone)]
 pub struct SaturatedAgent {
-    id: u32,
     model: AgentModel,
     control: ControlGains,
     /// `Ǎ_{i,j}` in neighbour order.
@@ -86,7 +85,6 @@ impl SaturatedAgent {
             vec: [initial.w],
         };
         Ok(Self {
-            id: cfg.id,
             gains: model.neighbours.iter().map(|n| n.a).collect(),
             held_nbrs: vec![Exchanged::identity(); model.neighbours.len()],
             held_leader: model.leader_gain.map(|_| Exchanged::identity()),
@@ -189,8 +187,12 @@ impl Stepper for SaturatedAgent {
         }
     }
 
-    fn sample(&self, step: u64) -> TelemetryMsg {
-        TelemetryMsg::agent(self.id, step, &self.state(), self.peak_torque)
+    fn sample(&self, step: u64) -> Telemetry {
+        Telemetry::Sample {
+            step,
+            state: self.state(),
+            peak_torque: self.peak_torque,
+        }
     }
 
     fn peak_torque(&self) -> f64 {

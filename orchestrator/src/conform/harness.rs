@@ -13,7 +13,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::{
-    ControlCommand, ControlMsg, Limits, PROTOCOL_VERSION, StateMsg, TelemetryKind, TelemetryMsg,
+    ControlCommand, ControlMsg, Limits, PROTOCOL_VERSION, StateMsg, Telemetry, TelemetryMsg,
 };
 use std::os::unix::process::CommandExt;
 use std::path::Path;
@@ -275,44 +275,39 @@ impl TelemetryCheck {
                     self.problem = Some(why);
                 }
             };
-            if m.version != PROTOCOL_VERSION {
-                bad(format!(
-                    "telemetry of version {}, expected {PROTOCOL_VERSION}",
-                    m.version
-                ));
-            }
             if m.sender != id {
                 bad(format!(
                     "telemetry claims sender {}, expected {id}",
                     m.sender
                 ));
             }
-            match TelemetryKind::from_u32(m.kind) {
-                Some(TelemetryKind::Ready) => self.ready = true,
-                Some(TelemetryKind::Sample) => {
-                    let x = m.agent_state();
-                    let finite = m.r.iter().chain(&m.w).all(|v| v.is_finite());
+            match m.decode() {
+                Err(e) => bad(format!("telemetry: {e}")),
+                Ok(Telemetry::Ready) => self.ready = true,
+                Ok(Telemetry::Sample { step, state, .. }) => {
+                    let finite = state.r.iter().chain(state.w.iter()).all(|v| v.is_finite());
                     if !finite
-                        || attitude::so3::orthogonality_defect(&x.r) > msgs::ROTATION_TOLERANCE
+                        || attitude::so3::orthogonality_defect(&state.r) > msgs::ROTATION_TOLERANCE
                     {
                         bad(format!(
-                            "sample at step {} is not finite or R is not a rotation",
-                            m.step
+                            "sample at step {step} is not finite or R is not a rotation"
                         ));
                     }
                     if self.done {
-                        bad(format!("sample at step {} after Done", m.step));
+                        bad(format!("sample at step {step} after Done"));
                     }
-                    self.seen.push(m.step);
+                    self.seen.push(step);
                 }
-                Some(TelemetryKind::Done) => {
-                    if m.step != steps {
-                        bad(format!("Done carries step {}, expected {steps}", m.step));
+                Ok(Telemetry::LeaderSample { step, .. }) => {
+                    bad(format!("sends the leader's sample (step {step})"));
+                }
+                Ok(Telemetry::Done(d)) => {
+                    if d.steps != steps {
+                        bad(format!("Done carries step {}, expected {steps}", d.steps));
                     }
                     self.done = true;
                 }
-                Some(TelemetryKind::LinkStats | TelemetryKind::Failed) => {}
-                None => bad(format!("telemetry of unknown kind {}", m.kind)),
+                Ok(Telemetry::LinkStats { .. } | Telemetry::Failed(_)) => {}
             }
         }
     }

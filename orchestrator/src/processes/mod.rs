@@ -16,7 +16,9 @@ use iceoryx2::node::NodeBuilder;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use msgs::config::{NodeConfig, Role, WaitStrategy};
-use msgs::{ControlCommand, ControlMsg, Limits, PROTOCOL_VERSION, TelemetryKind, TelemetryMsg};
+use msgs::{
+    ControlCommand, ControlMsg, Done, FailReason, Limits, PROTOCOL_VERSION, Telemetry, TelemetryMsg,
+};
 use namespace::Namespace;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -89,6 +91,8 @@ pub struct Outcome {
     /// Real-time pacing per agent (network order): (stages started more
     /// than a step late, largest lateness in wall s).
     pub pacing: Vec<(u64, f64)>,
+    /// What each node that finished reported with `Done`: (name, id, report).
+    pub nodes: Vec<(String, u32, Done)>,
 }
 
 fn iox<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> ProcessError {
@@ -202,7 +206,8 @@ pub fn run(
     let n_nodes = net.agents.len() + 1;
 
     set_log_level(LogLevel::Error);
-    let cfg = msgs::namespace::config(&run, ns.dir()).map_err(ProcessError::Iceoryx)?;
+    let cfg = msgs::namespace::config(&run, ns.dir())
+        .map_err(|e| ProcessError::Iceoryx(e.to_string()))?;
     let node = NodeBuilder::new()
         .name(&"orchestrator".try_into().map_err(iox("node name"))?)
         .config(&cfg)
@@ -271,7 +276,7 @@ pub fn run(
         peaks: vec![0.0; n_nodes],
         steps: 0,
         links: Vec::new(),
-        pacing: vec![(0, 0.0); n_nodes],
+        reports: vec![None; n_nodes],
         blamed: Vec::new(),
         gave_up: Vec::new(),
         broke_protocol: Vec::new(),
@@ -382,7 +387,8 @@ pub fn run(
                 return Ok(Outcome {
                     peak_torques: c.peaks[1..].to_vec(),
                     links: std::mem::take(&mut c.links),
-                    pacing: c.pacing[1..].to_vec(),
+                    pacing: c.pacing(),
+                    nodes: c.nodes(net),
                     steps: c.steps,
                     failure: Some(format!("nodes failed at shutdown: {}", bad.join("; "))),
                 });
@@ -401,8 +407,9 @@ pub fn run(
     c.links.sort_by_key(|&(f, t, _)| (f, t));
     Ok(Outcome {
         peak_torques: c.peaks[1..].to_vec(),
+        pacing: c.pacing(),
+        nodes: c.nodes(net),
         links: c.links,
-        pacing: c.pacing[1..].to_vec(),
         steps: c.steps,
         failure,
     })
@@ -434,14 +441,14 @@ fn check_exits(
 
 /// Telemetry bookkeeping.
 struct Collector {
-    pending: Vec<VecDeque<TelemetryMsg>>,
+    pending: Vec<VecDeque<(u64, Sampled)>>,
     ready: Vec<bool>,
     done: Vec<bool>,
     peaks: Vec<f64>,
     steps: u64,
     links: Vec<(u32, u32, LinkStats)>,
-    /// Real-time pacing per node: (stages started over a step late, largest lateness, s).
-    pacing: Vec<(u64, f64)>,
+    /// Each node's `Done` report, once it came.
+    reports: Vec<Option<Done>>,
     /// (node index, id of the input it timed out waiting for).
     blamed: Vec<(usize, u32)>,
     /// Nodes that reported giving up.
@@ -450,7 +457,36 @@ struct Collector {
     broke_protocol: Vec<u32>,
 }
 
+/// A decoded sample waiting for the rest of its snapshot.
+#[derive(Debug, Clone, Copy)]
+enum Sampled {
+    Leader(LeaderState),
+    Agent(AgentState),
+}
+
 impl Collector {
+    /// Real-time pacing per agent (network order).
+    fn pacing(&self) -> Vec<(u64, f64)> {
+        self.reports[1..]
+            .iter()
+            .map(|r| r.map_or((0, 0.0), |d| (d.pacing.late_stages, d.pacing.max_lateness)))
+            .collect()
+    }
+
+    /// The `Done` reports: (name, id, report) per node that sent one.
+    fn nodes(&self, net: &Network) -> Vec<(String, u32, Done)> {
+        let id = |i: usize| {
+            if i == 0 {
+                0
+            } else {
+                net.agents[i - 1].model.id
+            }
+        };
+        (self.reports.iter().enumerate())
+            .filter_map(|(i, r)| r.map(|d| (node_name(net, i), id(i), d)))
+            .collect()
+    }
+
     /// Names the nodes others gave up waiting for, if any did.
     fn blame(&self, net: &Network, plugins: &[Plugin]) -> Option<String> {
         // Node index: 0 the leader, 1 + the agent's index.
@@ -509,72 +545,84 @@ impl Collector {
                     Err(e) => return Err(format!("telemetry receive: {e:?}")),
                 };
                 any = true;
-                if m.version != PROTOCOL_VERSION {
-                    return Err(format!(
-                        "node {} speaks protocol version {}, attsync {PROTOCOL_VERSION}",
-                        m.sender, m.version
-                    ));
-                }
-                match TelemetryKind::from_u32(m.kind) {
-                    Some(TelemetryKind::Ready) => self.ready[i] = true,
-                    Some(TelemetryKind::Sample) => {
-                        self.peaks[i] = self.peaks[i].max(m.peak_torque);
-                        self.pending[i].push_back(m);
-                    }
-                    Some(TelemetryKind::LinkStats) => {
-                        let (from, st) = m.decode_link_stats();
-                        self.links.push((from, m.sender, st));
-                    }
-                    Some(TelemetryKind::Done) => {
-                        self.done[i] = true;
-                        self.peaks[i] = m.peak_torque;
-                        self.pacing[i] = (m.w[0] as u64, m.w[1]);
-                    }
-                    Some(TelemetryKind::Failed) => {
-                        self.gave_up.push(i);
-                        if let Ok(id) = u32::try_from(m.step) {
-                            self.blamed.push((i, id));
-                            if m.w[0] == 2.0 {
-                                self.broke_protocol.push(id);
-                            }
-                        }
-                    }
-                    None => {
-                        return Err(format!(
-                            "node {} sent telemetry of unknown kind {}",
-                            m.sender, m.kind
-                        ));
-                    }
-                }
+                let t = m
+                    .decode()
+                    .map_err(|e| format!("node {}'s telemetry: {e}", m.sender))?;
+                self.take(i, m.sender, t);
             }
         }
         Ok(any)
+    }
+
+    /// Books report `t` of node index `i` (id `sender`).
+    fn take(&mut self, i: usize, sender: u32, t: Telemetry) {
+        match t {
+            Telemetry::Ready => self.ready[i] = true,
+            Telemetry::Sample {
+                step,
+                state,
+                peak_torque,
+            } => {
+                self.peaks[i] = self.peaks[i].max(peak_torque);
+                self.pending[i].push_back((step, Sampled::Agent(state)));
+            }
+            Telemetry::LeaderSample { step, state } => {
+                self.pending[i].push_back((step, Sampled::Leader(state)));
+            }
+            Telemetry::LinkStats { from, stats } => self.links.push((from, sender, stats)),
+            Telemetry::Done(d) => {
+                self.done[i] = true;
+                self.peaks[i] = d.peak_torque;
+                self.reports[i] = Some(d);
+            }
+            Telemetry::Failed(reason) => {
+                self.gave_up.push(i);
+                match reason {
+                    FailReason::InputTimeout { from } => self.blamed.push((i, from)),
+                    FailReason::BadInput { from } => {
+                        self.blamed.push((i, from));
+                        self.broke_protocol.push(from);
+                    }
+                    FailReason::Other => {}
+                }
+            }
+        }
     }
 
     /// The next complete snapshot, if every node has sent it.
     #[allow(clippy::type_complexity)]
     fn next_snapshot(
         &mut self,
-        _net: &Network,
+        net: &Network,
     ) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, String> {
         if self.pending.iter().any(VecDeque::is_empty) {
             return Ok(None);
         }
-        let step = self.pending[0][0].step;
-        if let Some(m) = self.pending.iter().map(|q| &q[0]).find(|m| m.step != step) {
+        let step = self.pending[0][0].0;
+        if let Some((i, q)) = (self.pending.iter().enumerate()).find(|(_, q)| q[0].0 != step) {
             return Err(format!(
-                "telemetry out of step: node {} at step {}, leader at {step}",
-                m.sender, m.step
+                "telemetry out of step: {} at step {}, leader at {step}",
+                node_name(net, i),
+                q[0].0
             ));
         }
-        let leader = self.pending[0]
-            .pop_front()
-            .expect("non-empty")
-            .leader_state();
-        let agents = self.pending[1..]
+        let mut samples = self
+            .pending
             .iter_mut()
-            .map(|q| q.pop_front().expect("non-empty").agent_state())
-            .collect();
+            .map(|q| q.pop_front().expect("non-empty").1);
+        let Some(Sampled::Leader(leader)) = samples.next() else {
+            return Err("the leader sent an agent's sample".into());
+        };
+        let agents = samples
+            .enumerate()
+            .map(|(k, s)| match s {
+                Sampled::Agent(a) => Ok(a),
+                Sampled::Leader(_) => Err(format!(
+                    "{} sent the leader's sample",
+                    node_name(net, k + 1)
+                )),
+            })
+            .collect::<Result<_, _>>()?;
         Ok(Some((step, leader, agents)))
     }
 }

@@ -20,7 +20,7 @@
 use attitude::engine::Snapshot;
 use attitude::network::{AgentState, Network};
 use attitude::reference::LeaderState;
-use msgs::TelemetryMsg;
+use msgs::to_rows;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Write};
@@ -91,28 +91,26 @@ pub struct Record {
     pub agents: Vec<AgentRecord>,
 }
 
-// NOTE: the row-major conversion is msgs' (`TelemetryMsg::leader`/`agent`,
-// the same the process engine's telemetry carries), so it exists once.
+// NOTE: the row-major conversion is msgs' (`msgs::to_rows`, the one every
+// payload uses), so a matrix is laid out the same way on the wire and here.
 impl LeaderRecord {
     fn of(l: &LeaderState) -> Self {
-        let m = TelemetryMsg::leader(0, l);
         Self {
-            r0: m.r,
-            w0: m.w,
-            s0: m.s_hat,
+            r0: to_rows(&l.r0),
+            w0: l.w0.into(),
+            s0: l.s0.into(),
         }
     }
 }
 
 impl AgentRecord {
     fn of(x: &AgentState) -> Self {
-        let m = TelemetryMsg::agent(0, 0, x, 0.0);
         Self {
-            r: m.r,
-            w: m.w,
-            r_hat: m.r_hat,
-            w_hat: m.w_hat,
-            s_hat: m.s_hat,
+            r: to_rows(&x.r),
+            w: x.w.into(),
+            r_hat: to_rows(&x.r_hat),
+            w_hat: x.w_hat.into(),
+            s_hat: x.s_hat.into(),
         }
     }
 }

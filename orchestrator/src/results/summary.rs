@@ -92,6 +92,24 @@ pub struct Summary {
     /// Real-time factor (simulated s per wall s), `None` for lockstep.
     #[serde(default)]
     pub realtime: Option<f64>,
+    /// Processes engine: what every node that finished reported (empty in-process).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub nodes: Vec<NodeSummary>,
+}
+
+/// One node process of a processes-engine run, from its `Done` report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NodeSummary {
+    /// Node id (0 = the leader).
+    pub id: u32,
+    /// `leader` or `agent-<id>`.
+    pub name: String,
+    /// Peak resident set size of the process, kB.
+    pub peak_rss_kb: u64,
+    /// Wall time it began stepping, ns since the Unix epoch.
+    pub started_unix_ns: u64,
+    /// Wall time it finished its last step, ns since the Unix epoch.
+    pub done_unix_ns: u64,
 }
 
 /// Time after which `err` stays below `threshold`: the sample after the last

@@ -31,7 +31,9 @@ use iceoryx2::service::builder::publish_subscribe::{
     PublishSubscribeOpenError, PublishSubscribeOpenOrCreateError,
 };
 use msgs::config::NodeConfig;
-use msgs::{ControlCommand, PROTOCOL_VERSION, StateMsg, TelemetryKind, TelemetryMsg, names, open};
+use msgs::{
+    ControlCommand, Done, PROTOCOL_VERSION, StateMsg, Telemetry, TelemetryMsg, names, open,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -93,8 +95,8 @@ fn main() -> ExitCode {
         }
     };
     let result = config_path().and_then(|path| {
-        let cfg = NodeConfig::read(&path)?;
-        let node = create_node(&cfg, &format!("agent_{}", cfg.id))?;
+        let cfg = NodeConfig::read(&path).map_err(|e| e.to_string())?;
+        let node = create_node(&cfg, &format!("agent_{}", cfg.id)).map_err(|e| e.to_string())?;
         info!(id = cfg.id, ?fault, "broken agent");
         match fault {
             None => {
@@ -267,8 +269,10 @@ fn lockstep<S: Service>(node: &Node<S>, cfg: &NodeConfig, fault: Fault) -> Resul
                 .map_err(iox("wake notifier"))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let report = |m: TelemetryMsg| -> Result<(), String> {
-        tele_pub.send_copy(m).map_err(iox("telemetry send"))?;
+    let report = |t: Telemetry| -> Result<(), String> {
+        tele_pub
+            .send_copy(TelemetryMsg::encode(id, &t))
+            .map_err(iox("telemetry send"))?;
         let _ = orch.notify();
         Ok(())
     };
@@ -292,7 +296,7 @@ fn lockstep<S: Service>(node: &Node<S>, cfg: &NodeConfig, fault: Fault) -> Resul
         }
         std::thread::sleep(Duration::from_millis(1));
     }
-    report(TelemetryMsg::bare(id, 0, TelemetryKind::Ready, 0.0))?;
+    report(Telemetry::Ready)?;
     let command = |timeout: Duration| -> Result<Option<ControlCommand>, String> {
         let deadline = Instant::now() + timeout;
         loop {
@@ -377,12 +381,11 @@ fn lockstep<S: Service>(node: &Node<S>, cfg: &NodeConfig, fault: Fault) -> Resul
             report(model.sample(done))?;
         }
     }
-    report(TelemetryMsg::bare(
-        id,
-        cfg.steps,
-        TelemetryKind::Done,
-        model.peak_torque(),
-    ))?;
+    report(Telemetry::Done(Done {
+        steps: cfg.steps,
+        peak_torque: model.peak_torque(),
+        ..Done::default()
+    }))?;
     if fault == Fault::NeverStops {
         warn!("fault: ignoring Stop; sleeping until killed");
         // Bounded only by the parent's life, so that a test that forgets

@@ -1,0 +1,488 @@
+//! Telemetry: what a node reports to the orchestrator, as a typed
+//! [`Telemetry`] value, and its wire form [`TelemetryMsg`]. Encoding
+//! ([`TelemetryMsg::encode`]) and decoding ([`TelemetryMsg::decode`]) sit
+//! side by side; PROTOCOL.md § 5 gives the same byte layout per kind.
+//!
+//! The wire form is a 16-byte header (`version`, `sender`, `kind`,
+//! `reserved`) and a 232-byte body whose layout depends on the kind. Every
+//! counter is a `u64`, every quantity an `f64`, every code a `u32`: nothing
+//! travels as another type, and unused bytes are 0.
+
+use crate::payload::{PROTOCOL_VERSION, from_rows, to_rows};
+use attitude::link::LinkStats;
+use attitude::network::AgentState;
+use attitude::reference::LeaderState;
+use iceoryx2::prelude::ZeroCopySend;
+use nalgebra::Vector3;
+use thiserror::Error;
+
+/// Bytes of the body of a [`TelemetryMsg`].
+pub const BODY_BYTES: usize = 232;
+
+/// A node's report to the orchestrator, decoded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Telemetry {
+    /// The node has connected all its ports and waits for `Start`.
+    Ready,
+    /// An agent's state at the start of step `step`.
+    Sample {
+        /// Step index n (the state at t = n·dt).
+        step: u64,
+        /// The body and observer state.
+        state: AgentState,
+        /// Largest ‖τᵢ‖ applied so far, N·m.
+        peak_torque: f64,
+    },
+    /// The leader's state at the start of step `step`.
+    LeaderSample {
+        /// Step index n.
+        step: u64,
+        /// `R₀, ω₀, σ₀`.
+        state: LeaderState,
+    },
+    /// Counters of one incoming link, reported before `Done`.
+    LinkStats {
+        /// The sender of the link.
+        from: u32,
+        /// Its counters.
+        stats: LinkStats,
+    },
+    /// The node has done its last step.
+    Done(Done),
+    /// The node gives up while stepping, just before it exits.
+    Failed(FailReason),
+}
+
+/// The end of a node's steps.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Done {
+    /// Steps done (= the configuration's `steps`).
+    pub steps: u64,
+    /// Largest ‖τᵢ‖ applied, N·m (0 for the leader).
+    pub peak_torque: f64,
+    /// Peak resident set size of the node's process (VmHWM), kB; 0 if unknown.
+    pub peak_rss_kb: u64,
+    /// Wall time at which the node began stepping (after `Start`), ns since the Unix epoch.
+    pub started_unix_ns: u64,
+    /// Wall time at which it finished its last step, ns since the Unix epoch.
+    pub done_unix_ns: u64,
+    /// How well the node kept to its schedule (real-time mode; zeros in lockstep).
+    pub pacing: Pacing,
+}
+
+/// Real-time pacing of one node.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Pacing {
+    /// Stages started more than one step (dt/factor of wall time) late.
+    pub late_stages: u64,
+    /// Largest lateness of a stage start, wall s.
+    pub max_lateness: f64,
+}
+
+/// Why a node gave up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FailReason {
+    /// The state of input `from` did not arrive within `stage_timeout`.
+    InputTimeout {
+        /// The input waited for.
+        from: u32,
+    },
+    /// Input `from` broke the protocol (wrong stamp, version or sender).
+    BadInput {
+        /// The offending input.
+        from: u32,
+    },
+    /// Anything else (e.g. a receiver that stopped reading its state).
+    Other,
+}
+
+/// Wire codes of [`Telemetry`] kinds (`kind` field).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum TelemetryKind {
+    /// [`Telemetry::Ready`].
+    Ready = 1,
+    /// [`Telemetry::Sample`].
+    Sample = 2,
+    /// [`Telemetry::Done`].
+    Done = 3,
+    /// [`Telemetry::LinkStats`].
+    LinkStats = 4,
+    /// [`Telemetry::Failed`].
+    Failed = 5,
+    /// [`Telemetry::LeaderSample`].
+    LeaderSample = 6,
+}
+
+impl TelemetryKind {
+    fn of(t: &Telemetry) -> Self {
+        match t {
+            Telemetry::Ready => Self::Ready,
+            Telemetry::Sample { .. } => Self::Sample,
+            Telemetry::LeaderSample { .. } => Self::LeaderSample,
+            Telemetry::LinkStats { .. } => Self::LinkStats,
+            Telemetry::Done(_) => Self::Done,
+            Telemetry::Failed(_) => Self::Failed,
+        }
+    }
+}
+
+/// Wire codes of [`FailReason`]s.
+const REASON_INPUT_TIMEOUT: u32 = 1;
+const REASON_BAD_INPUT: u32 = 2;
+const REASON_OTHER: u32 = 3;
+
+/// A telemetry message that cannot be decoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+pub enum TelemetryError {
+    /// The sender speaks another protocol version.
+    #[error("it speaks protocol version {theirs}, attsync {ours}")]
+    Version {
+        /// The message's version.
+        theirs: u32,
+        /// [`PROTOCOL_VERSION`].
+        ours: u32,
+    },
+    /// The `kind` field holds no known kind.
+    #[error("unknown telemetry kind {0}")]
+    UnknownKind(u32),
+    /// A `Failed` message with an unknown reason code.
+    #[error("unknown failure reason {0}")]
+    UnknownReason(u32),
+}
+
+/// A node's report to the orchestrator, as it travels. Service
+/// `attsync/<run>/node/<id>/telemetry`. Build it with [`Self::encode`],
+/// read it with [`Self::decode`].
+#[derive(Debug, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("attsync::TelemetryMsg")]
+pub struct TelemetryMsg {
+    /// [`PROTOCOL_VERSION`].
+    pub version: u32,
+    /// Sender's node id.
+    pub sender: u32,
+    /// [`TelemetryKind`] as `u32`.
+    pub kind: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// Kind-dependent fields, little-endian (PROTOCOL.md § 5); the byte at
+    /// message offset `o` is `body[o − 16]`.
+    pub body: [u8; BODY_BYTES],
+}
+
+impl TelemetryMsg {
+    /// `t` as sent by node `sender`.
+    #[must_use]
+    pub fn encode(sender: u32, t: &Telemetry) -> Self {
+        let mut b = Writer([0; BODY_BYTES]);
+        match t {
+            Telemetry::Ready => {}
+            Telemetry::Sample {
+                step,
+                state,
+                peak_torque,
+            } => {
+                b.u64(16, *step);
+                b.f64s(24, &to_rows(&state.r));
+                b.f64s(96, state.w.as_slice());
+                b.f64s(120, &to_rows(&state.r_hat));
+                b.f64s(192, state.w_hat.as_slice());
+                b.f64s(216, state.s_hat.as_slice());
+                b.f64(240, *peak_torque);
+            }
+            Telemetry::LeaderSample { step, state } => {
+                b.u64(16, *step);
+                b.f64s(24, &to_rows(&state.r0));
+                b.f64s(96, state.w0.as_slice());
+                b.f64s(120, state.s0.as_slice());
+            }
+            Telemetry::LinkStats { from, stats } => encode_link_stats(&mut b, *from, stats),
+            Telemetry::Done(d) => encode_done(&mut b, d),
+            Telemetry::Failed(f) => encode_failed(&mut b, f),
+        }
+        Self {
+            version: PROTOCOL_VERSION,
+            sender,
+            kind: TelemetryKind::of(t) as u32,
+            reserved: 0,
+            body: b.0,
+        }
+    }
+
+    /// The report this message carries.
+    pub fn decode(&self) -> Result<Telemetry, TelemetryError> {
+        if self.version != PROTOCOL_VERSION {
+            return Err(TelemetryError::Version {
+                theirs: self.version,
+                ours: PROTOCOL_VERSION,
+            });
+        }
+        let b = Reader(&self.body);
+        Ok(match self.kind {
+            1 => Telemetry::Ready,
+            2 => Telemetry::Sample {
+                step: b.u64(16),
+                state: AgentState {
+                    r: from_rows(&b.f64s(24)),
+                    w: Vector3::from(b.f64s(96)),
+                    r_hat: from_rows(&b.f64s(120)),
+                    w_hat: Vector3::from(b.f64s(192)),
+                    s_hat: Vector3::from(b.f64s(216)),
+                },
+                peak_torque: b.f64(240),
+            },
+            6 => Telemetry::LeaderSample {
+                step: b.u64(16),
+                state: LeaderState {
+                    r0: from_rows(&b.f64s(24)),
+                    w0: Vector3::from(b.f64s(96)),
+                    s0: Vector3::from(b.f64s(120)),
+                },
+            },
+            4 => decode_link_stats(&b),
+            3 => Telemetry::Done(decode_done(&b)),
+            5 => Telemetry::Failed(decode_failed(&b)?),
+            k => return Err(TelemetryError::UnknownKind(k)),
+        })
+    }
+}
+
+fn encode_link_stats(b: &mut Writer, from: u32, s: &LinkStats) {
+    b.u32(16, from);
+    b.u64(24, s.sent);
+    b.u64(32, s.delivered);
+    b.u64(40, s.lost);
+    b.u64(48, s.rejected);
+    b.u64(56, s.evaluations);
+    b.f64(64, s.age_sum);
+    b.f64(72, s.age_max);
+}
+
+fn decode_link_stats(b: &Reader) -> Telemetry {
+    Telemetry::LinkStats {
+        from: b.u32(16),
+        stats: LinkStats {
+            sent: b.u64(24),
+            delivered: b.u64(32),
+            lost: b.u64(40),
+            rejected: b.u64(48),
+            evaluations: b.u64(56),
+            age_sum: b.f64(64),
+            age_max: b.f64(72),
+        },
+    }
+}
+
+fn encode_done(b: &mut Writer, d: &Done) {
+    b.u64(16, d.steps);
+    b.f64(24, d.peak_torque);
+    b.u64(32, d.peak_rss_kb);
+    b.u64(40, d.started_unix_ns);
+    b.u64(48, d.done_unix_ns);
+    b.u64(56, d.pacing.late_stages);
+    b.f64(64, d.pacing.max_lateness);
+}
+
+fn decode_done(b: &Reader) -> Done {
+    Done {
+        steps: b.u64(16),
+        peak_torque: b.f64(24),
+        peak_rss_kb: b.u64(32),
+        started_unix_ns: b.u64(40),
+        done_unix_ns: b.u64(48),
+        pacing: Pacing {
+            late_stages: b.u64(56),
+            max_lateness: b.f64(64),
+        },
+    }
+}
+
+fn encode_failed(b: &mut Writer, f: &FailReason) {
+    let (code, from) = match *f {
+        FailReason::InputTimeout { from } => (REASON_INPUT_TIMEOUT, from),
+        FailReason::BadInput { from } => (REASON_BAD_INPUT, from),
+        FailReason::Other => (REASON_OTHER, 0),
+    };
+    b.u32(16, code);
+    b.u32(20, from);
+}
+
+fn decode_failed(b: &Reader) -> Result<FailReason, TelemetryError> {
+    let from = b.u32(20);
+    match b.u32(16) {
+        REASON_INPUT_TIMEOUT => Ok(FailReason::InputTimeout { from }),
+        REASON_BAD_INPUT => Ok(FailReason::BadInput { from }),
+        REASON_OTHER => Ok(FailReason::Other),
+        code => Err(TelemetryError::UnknownReason(code)),
+    }
+}
+
+/// Writes little-endian fields at message offsets (≥ 16) into a body.
+struct Writer([u8; BODY_BYTES]);
+
+impl Writer {
+    fn put(&mut self, at: usize, bytes: &[u8]) {
+        self.0[at - 16..at - 16 + bytes.len()].copy_from_slice(bytes);
+    }
+    fn u32(&mut self, at: usize, v: u32) {
+        self.put(at, &v.to_le_bytes());
+    }
+    fn u64(&mut self, at: usize, v: u64) {
+        self.put(at, &v.to_le_bytes());
+    }
+    fn f64(&mut self, at: usize, v: f64) {
+        self.put(at, &v.to_le_bytes());
+    }
+    fn f64s(&mut self, at: usize, v: &[f64]) {
+        for (k, x) in v.iter().enumerate() {
+            self.f64(at + 8 * k, *x);
+        }
+    }
+}
+
+/// Reads little-endian fields at message offsets (≥ 16) from a body.
+struct Reader<'a>(&'a [u8; BODY_BYTES]);
+
+impl Reader<'_> {
+    fn get<const N: usize>(&self, at: usize) -> [u8; N] {
+        let mut out = [0; N];
+        out.copy_from_slice(&self.0[at - 16..at - 16 + N]);
+        out
+    }
+    fn u32(&self, at: usize) -> u32 {
+        u32::from_le_bytes(self.get(at))
+    }
+    fn u64(&self, at: usize) -> u64 {
+        u64::from_le_bytes(self.get(at))
+    }
+    fn f64(&self, at: usize) -> f64 {
+        f64::from_le_bytes(self.get(at))
+    }
+    fn f64s<const N: usize>(&self, at: usize) -> [f64; N] {
+        std::array::from_fn(|k| self.f64(at + 8 * k))
+    }
+}
+
+/// Peak resident set size of this process (VmHWM), kB; 0 if unknown.
+#[must_use]
+pub fn peak_rss_kb() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse().ok())
+        })
+        .unwrap_or(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Matrix3;
+    use std::mem::size_of;
+
+    fn agent_state() -> AgentState {
+        AgentState {
+            r: attitude::so3::rot(0.3, &Vector3::new(0.6, 0.0, 0.8)),
+            w: Vector3::new(1.0 / 3.0, -2.0, 1e-300),
+            r_hat: Matrix3::identity(),
+            w_hat: Vector3::new(f64::MIN_POSITIVE, 0.1, 7.0),
+            s_hat: Vector3::new(-0.0, 5e-324, 1e300),
+        }
+    }
+
+    #[test]
+    fn layout_is_the_documented_one() {
+        assert_eq!(size_of::<TelemetryMsg>(), 248);
+        assert_eq!(std::mem::offset_of!(TelemetryMsg, body), 16);
+        let m = TelemetryMsg::encode(
+            3,
+            &Telemetry::LinkStats {
+                from: 7,
+                stats: LinkStats {
+                    sent: (1 << 60) + 1, // not representable as f64
+                    ..LinkStats::default()
+                },
+            },
+        );
+        assert_eq!(m.kind, 4);
+        assert_eq!(m.body[0], 7);
+        assert_eq!(
+            u64::from_le_bytes(m.body[8..16].try_into().unwrap()),
+            (1 << 60) + 1
+        );
+    }
+
+    #[test]
+    fn every_kind_round_trips_bit_exactly() {
+        let all = [
+            Telemetry::Ready,
+            Telemetry::Sample {
+                step: 17,
+                state: agent_state(),
+                peak_torque: 2.5,
+            },
+            Telemetry::LeaderSample {
+                step: u64::MAX,
+                state: LeaderState {
+                    r0: agent_state().r,
+                    w0: Vector3::new(0.1, 0.2, 0.3),
+                    s0: Vector3::new(-1.0, 0.0, 1e-10),
+                },
+            },
+            Telemetry::LinkStats {
+                from: 2,
+                stats: LinkStats {
+                    sent: 40_000,
+                    delivered: 39_999,
+                    lost: 1,
+                    age_sum: 0.25,
+                    age_max: 1e-3,
+                    evaluations: 160_000,
+                    rejected: u64::MAX,
+                },
+            },
+            Telemetry::Done(Done {
+                steps: 40_000,
+                peak_torque: 9.75,
+                peak_rss_kb: 8_912,
+                started_unix_ns: 1_764_600_000_000_000_000,
+                done_unix_ns: 1_764_600_001_900_000_000,
+                pacing: Pacing {
+                    late_stages: 3,
+                    max_lateness: 0.007,
+                },
+            }),
+            Telemetry::Failed(FailReason::InputTimeout { from: 5 }),
+            Telemetry::Failed(FailReason::BadInput { from: 0 }),
+            Telemetry::Failed(FailReason::Other),
+        ];
+        for t in all {
+            let m = TelemetryMsg::encode(4, &t);
+            assert_eq!(m.sender, 4);
+            assert_eq!(m.decode(), Ok(t), "{t:?}");
+        }
+    }
+
+    #[test]
+    fn foreign_versions_kinds_and_reasons_are_refused() {
+        let mut m = TelemetryMsg::encode(1, &Telemetry::Ready);
+        m.version = 2;
+        assert_eq!(
+            m.decode(),
+            Err(TelemetryError::Version {
+                theirs: 2,
+                ours: PROTOCOL_VERSION
+            })
+        );
+        let mut m = TelemetryMsg::encode(1, &Telemetry::Ready);
+        m.kind = 9;
+        assert_eq!(m.decode(), Err(TelemetryError::UnknownKind(9)));
+        let mut m = TelemetryMsg::encode(1, &Telemetry::Failed(FailReason::Other));
+        m.body[0] = 77;
+        assert_eq!(m.decode(), Err(TelemetryError::UnknownReason(77)));
+    }
+}
