@@ -55,7 +55,11 @@ fn check_table(report: &str, heading: &str) {
     assert!(!rows.is_empty(), "{heading}: no rows:\n{report}");
     for row in rows {
         let c = cells(row);
-        assert_eq!(c.len(), header.len(), "{heading}: row {row:?} vs {header:?}");
+        assert_eq!(
+            c.len(),
+            header.len(),
+            "{heading}: row {row:?} vs {header:?}"
+        );
         for (name, value) in header.iter().zip(&c) {
             assert!(
                 !value.is_empty() && !value.contains('—'),
@@ -69,7 +73,14 @@ fn check_table(report: &str, heading: &str) {
 fn quickest_case_reports_every_figure() {
     let scenarios = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper");
     let out = Command::new(env!("CARGO_BIN_EXE_attsync-bench"))
-        .args(["run", "--quick", "--only", "paper-timevarying", "--wait", "adaptive"])
+        .args([
+            "run",
+            "--quick",
+            "--only",
+            "paper-timevarying",
+            "--wait",
+            "adaptive",
+        ])
         .args(["--reps", "1", "--duration", "0.2", "--idle-wait", "0"])
         .arg("--scenarios")
         .arg(&scenarios)

@@ -58,7 +58,7 @@ pub(crate) fn exec_lock() -> std::sync::MutexGuard<'static, ()> {
 }
 
 /// Copies executable `from` to `to` (safe against concurrent
-/// [`Attsync::spawn`]s of this test binary, see `ETXTBSY`).
+/// [`Attsync::spawn`](crate::Attsync::spawn)s of this test binary, see `ETXTBSY`).
 pub fn copy_executable(from: &Path, to: &Path) {
     let _no_fork = exec_lock();
     fs::copy(from, to)

@@ -13,7 +13,7 @@
 //!
 //! # Layout
 //! - [`plan`]: durations, the cases, the spin rule.
-//! - [`run`]: running the measurements and aggregating repetitions.
+//! - [`run`](mod@run): running the measurements and aggregating repetitions.
 //! - [`report`]: the Markdown report.
 //! - this file: [`Options`] and the driver [`run()`].
 
