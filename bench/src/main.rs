@@ -17,15 +17,27 @@
 //! `attsync-bench ring-node …` is internal: one process of the bare ring,
 //! started by `run` (see [`ring`]).
 //!
-//! The benchmark is not part of `cargo test` (its unit tests check parsing
-//! and statistics only; nothing is timed).
+//! The benchmark is not part of `cargo test`: its unit tests check parsing
+//! and statistics, and `tests/quick.rs` runs one short case end to end and
+//! checks that every figure of the report was measured; nothing is timed.
+//!
+//! # Layout
+//! - [`suite`]: `run` — the plan, the measurements, the report.
+//! - [`measure`]: one `attsync run`, its figures read from `summary.json`.
+//! - [`bare`]: one bare lockstep of `ring-node` processes; [`ring`]: one
+//!   `ring-node` process.
+//! - [`procs`]: child processes with bounded waits; [`stats`]: medians, CPU
+//!   load, the machine; [`error`]: [`error::BenchError`].
 
+mod bare;
+mod error;
 mod measure;
 mod procs;
 mod ring;
 mod stats;
 mod suite;
 
+use anyhow::{Context as _, bail};
 use clap::{Parser, Subcommand, ValueEnum};
 use msgs::config::WaitStrategy;
 use std::path::PathBuf;
@@ -52,6 +64,9 @@ enum Cmd {
         /// Repetitions per measurement (default 3, 1 with --quick).
         #[arg(long)]
         reps: Option<usize>,
+        /// Simulated seconds of every case (default: the plan's, see --quick).
+        #[arg(long)]
+        duration: Option<f64>,
         /// Only cases whose label contains this (repeatable): paper-timevarying, tree-32, …
         #[arg(long)]
         only: Vec<String>,
@@ -134,11 +149,11 @@ impl From<WaitArg> for WaitStrategy {
     }
 }
 
-fn id_list(s: Option<String>) -> Result<Option<Vec<u32>>, String> {
+fn id_list(s: Option<String>) -> anyhow::Result<Option<Vec<u32>>> {
     s.map(|s| {
         s.split(',')
             .filter(|x| !x.trim().is_empty())
-            .map(|x| x.trim().parse().map_err(|e| format!("node id {x:?}: {e}")))
+            .map(|x| x.trim().parse().with_context(|| format!("node id {x:?}")))
             .collect()
     })
     .transpose()
@@ -148,13 +163,13 @@ fn main() -> ExitCode {
     match dispatch(Cli::parse().command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("attsync-bench: {e}");
+            eprintln!("attsync-bench: {e:#}");
             ExitCode::FAILURE
         }
     }
 }
 
-fn dispatch(cmd: Cmd) -> Result<(), String> {
+fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
     match cmd {
         Cmd::RingNode {
             run,
@@ -189,6 +204,7 @@ fn dispatch(cmd: Cmd) -> Result<(), String> {
             quick,
             out,
             reps,
+            duration,
             only,
             wait,
             scenarios,
@@ -196,56 +212,87 @@ fn dispatch(cmd: Cmd) -> Result<(), String> {
             work,
             idle_wait,
         } => {
-            let bench = std::env::current_exe().map_err(|e| format!("own path: {e}"))?;
-            let dir = bin_dir
-                .or_else(|| bench.parent().map(PathBuf::from))
-                .unwrap_or_default();
-            for b in ["attsync", "attsync-agent", "attsync-leader"] {
-                if !dir.join(b).is_file() {
-                    return Err(format!(
-                        "{} is missing: build with `cargo build --release --workspace` or pass --bin-dir",
-                        dir.join(b).display()
-                    ));
-                }
-            }
-            let scenarios = scenarios.unwrap_or_else(|| {
-                let local = PathBuf::from("scenarios/paper");
-                if local.is_dir() {
-                    local
-                } else {
-                    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper"))
-                }
-            });
-            let (work, temporary) = match work {
-                Some(w) => (w, false),
-                None => (
-                    std::env::temp_dir().join(format!("attsync-bench-{}", std::process::id())),
-                    true,
-                ),
-            };
-            let opts = suite::Options {
+            let opts = RunArgs {
                 quick,
                 reps,
+                duration,
                 only,
-                waits: wait.into_iter().map(WaitStrategy::from).collect(),
+                wait,
                 scenarios,
-                work: work.clone(),
-                idle_wait: std::time::Duration::from_secs(idle_wait),
-                bins: measure::Bins {
-                    attsync: dir.join("attsync"),
-                    bench,
-                },
+                bin_dir,
+                work,
+                idle_wait,
             };
-            let result = suite::run(&opts);
-            if temporary {
-                let _ = std::fs::remove_dir_all(&work);
-            }
-            let report = result?;
-            println!("{report}");
-            if let Some(path) = out {
-                std::fs::write(&path, &report).map_err(|e| format!("{}: {e}", path.display()))?;
-            }
-            Ok(())
+            run(opts, out)
         }
     }
+}
+
+/// The arguments of `run` that become [`suite::Options`].
+struct RunArgs {
+    quick: bool,
+    reps: Option<usize>,
+    duration: Option<f64>,
+    only: Vec<String>,
+    wait: Vec<WaitArg>,
+    scenarios: Option<PathBuf>,
+    bin_dir: Option<PathBuf>,
+    work: Option<PathBuf>,
+    idle_wait: u64,
+}
+
+/// `attsync-bench run`: checks the programs, runs the suite, prints (and writes) the report.
+fn run(a: RunArgs, out: Option<PathBuf>) -> anyhow::Result<()> {
+    let bench = std::env::current_exe().context("own path")?;
+    let dir = a
+        .bin_dir
+        .or_else(|| bench.parent().map(PathBuf::from))
+        .unwrap_or_default();
+    for b in ["attsync", "attsync-agent", "attsync-leader"] {
+        if !dir.join(b).is_file() {
+            bail!(
+                "{} is missing: build with `cargo build --release --workspace` or pass --bin-dir",
+                dir.join(b).display()
+            );
+        }
+    }
+    let scenarios = a.scenarios.unwrap_or_else(|| {
+        let local = PathBuf::from("scenarios/paper");
+        if local.is_dir() {
+            local
+        } else {
+            PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper"))
+        }
+    });
+    let (work, temporary) = match a.work {
+        Some(w) => (w, false),
+        None => (
+            std::env::temp_dir().join(format!("attsync-bench-{}", std::process::id())),
+            true,
+        ),
+    };
+    let opts = suite::Options {
+        quick: a.quick,
+        reps: a.reps,
+        duration: a.duration,
+        only: a.only,
+        waits: a.wait.into_iter().map(WaitStrategy::from).collect(),
+        scenarios,
+        work: work.clone(),
+        idle_wait: std::time::Duration::from_secs(a.idle_wait),
+        bins: measure::Bins {
+            attsync: dir.join("attsync"),
+            bench,
+        },
+    };
+    let result = suite::run(&opts);
+    if temporary {
+        let _ = std::fs::remove_dir_all(&work);
+    }
+    let report = result?;
+    println!("{report}");
+    if let Some(path) = out {
+        std::fs::write(&path, &report).with_context(|| path.display().to_string())?;
+    }
+    Ok(())
 }

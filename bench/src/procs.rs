@@ -4,6 +4,7 @@
 //! Only processes this program started are ever signalled, by their own
 //! process id.
 
+use crate::error::{BenchError, Result};
 use std::path::Path;
 use std::process::{Child, Command, ExitStatus};
 use std::sync::mpsc;
@@ -29,11 +30,13 @@ fn signal(pid: u32, sig: &str) {
 /// measured from just before the spawn to the moment `waitpid` returns (a
 /// helper thread blocks in it, so nothing polls). After `timeout` the child
 /// gets SIGINT, 20 s later SIGKILL, and the result is an error.
-pub fn run_timed(cmd: &mut Command, timeout: Duration) -> Result<Finished, String> {
+pub fn run_timed(cmd: &mut Command, timeout: Duration) -> Result<Finished> {
+    let program = cmd.get_program().to_string_lossy().into_owned();
     let t0 = Instant::now();
-    let mut child = cmd
-        .spawn()
-        .map_err(|e| format!("cannot start {:?}: {e}", cmd.get_program()))?;
+    let mut child = cmd.spawn().map_err(|source| BenchError::Spawn {
+        program: program.clone(),
+        source,
+    })?;
     let pid = child.id();
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
@@ -42,7 +45,7 @@ pub fn run_timed(cmd: &mut Command, timeout: Duration) -> Result<Finished, Strin
     });
     match rx.recv_timeout(timeout) {
         Ok((status, t1)) => Ok(Finished {
-            status: status.map_err(|e| format!("waiting for the child: {e}"))?,
+            status: status.map_err(|source| BenchError::Spawn { program, source })?,
             wall: (t1 - t0).as_secs_f64(),
         }),
         Err(_) => {
@@ -51,10 +54,10 @@ pub fn run_timed(cmd: &mut Command, timeout: Duration) -> Result<Finished, Strin
                 signal(pid, "KILL");
                 let _ = rx.recv_timeout(Duration::from_secs(5));
             }
-            Err(format!(
-                "timed out after {:.0} s (interrupted)",
-                timeout.as_secs_f64()
-            ))
+            Err(BenchError::Timeout {
+                seconds: timeout.as_secs_f64(),
+                what: format!("for {program} (interrupted)"),
+            })
         }
     }
 }
@@ -82,13 +85,16 @@ impl Group {
     /// Waits until every child has exited, at most `timeout`; returns the
     /// statuses in start order, or an error naming those still running
     /// (which are then killed).
-    pub fn wait_all(&mut self, timeout: Duration) -> Result<Vec<(u32, ExitStatus)>, String> {
+    pub fn wait_all(&mut self, timeout: Duration) -> Result<Vec<(u32, ExitStatus)>> {
         let deadline = Instant::now() + timeout;
         let mut out: Vec<Option<ExitStatus>> = vec![None; self.children.len()];
         loop {
             for (k, (_, c)) in self.children.iter_mut().enumerate() {
                 if out[k].is_none() {
-                    out[k] = c.try_wait().map_err(|e| format!("waiting: {e}"))?;
+                    out[k] = c.try_wait().map_err(|source| BenchError::Spawn {
+                        program: "a ring-node (waiting for it)".into(),
+                        source,
+                    })?;
                 }
             }
             if out.iter().all(Option::is_some) {
@@ -108,11 +114,10 @@ impl Group {
                     .map(|((i, _), _)| i.to_string())
                     .collect();
                 self.kill();
-                return Err(format!(
-                    "nodes still running after {:.0} s: {}",
-                    timeout.as_secs_f64(),
-                    running.join(", ")
-                ));
+                return Err(BenchError::Timeout {
+                    seconds: timeout.as_secs_f64(),
+                    what: format!("for nodes {} to end", running.join(", ")),
+                });
             }
             std::thread::sleep(Duration::from_millis(10));
         }

@@ -28,10 +28,17 @@
 //! `ring-node index=I steps=S start_unix=T0 end_unix=T1 elapsed=E peak_rss_kb=K`
 //! (times in seconds; `elapsed` covers the lockstep loop only).
 
+use crate::error::{BenchError, Result};
 use attsync_agent::wait::Waiter;
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::port::{BackpressureAction, BackpressureInfo};
 use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSub;
 use msgs::config::WaitStrategy;
 use msgs::{Limits, PROTOCOL_VERSION, StateMsg};
 use std::path::{Path, PathBuf};
@@ -147,23 +154,22 @@ fn poll_until(
     timeout: Duration,
     what: impl Fn() -> String,
     mut cond: impl FnMut() -> bool,
-) -> Result<(), String> {
+) -> Result<()> {
     let deadline = Instant::now() + timeout;
     while !cond() {
         if Instant::now() > deadline {
-            return Err(format!(
-                "timed out after {:.1} s waiting for {}",
-                timeout.as_secs_f64(),
-                what()
-            ));
+            return Err(BenchError::Timeout {
+                seconds: timeout.as_secs_f64(),
+                what: format!("waiting for {}", what()),
+            });
         }
         std::thread::sleep(Duration::from_millis(1));
     }
     Ok(())
 }
 
-fn touch(path: &Path) -> Result<(), String> {
-    std::fs::write(path, b"").map_err(|e| format!("{}: {e}", path.display()))
+fn touch(path: &Path) -> Result<()> {
+    std::fs::write(path, b"").map_err(BenchError::io(path))
 }
 
 /// The runtime's backpressure handler: yield and retry until `timeout`, then fail the send.
@@ -180,19 +186,129 @@ fn retry_until(
     }
 }
 
-fn port<E: std::fmt::Debug>(what: &str) -> impl FnOnce(E) -> String + '_ {
-    move |e| format!("{what}: {e:?}")
+/// A ring node's ports, opened exactly as the node runtime opens them.
+struct Ports {
+    /// Our state service (its subscriber count is the readiness condition).
+    own: PubSub<ipc::Service, StateMsg, ()>,
+    publisher: Publisher<ipc::Service, StateMsg, ()>,
+    listener: Listener<ipc::Service>,
+    /// One per input, in input order.
+    subs: Vec<Subscriber<ipc::Service, StateMsg, ()>>,
+    input_services: Vec<PubSub<ipc::Service, StateMsg, ()>>,
+    /// The wake events of our receivers.
+    notifiers: Vec<Notifier<ipc::Service>>,
+}
+
+impl Ports {
+    fn open(
+        node: &Node<ipc::Service>,
+        run: &str,
+        id: u32,
+        io: (&[u32], &[u32]),
+        limits: &Limits,
+        stage_timeout: Duration,
+    ) -> Result<Self> {
+        let (inputs, outputs) = io;
+        let own = msgs::open::state(node, run, id, limits).map_err(BenchError::iox_msg("state"))?;
+        let publisher = own
+            .publisher_builder()
+            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+            .set_backpressure_handler(retry_until(stage_timeout))
+            .create()
+            .map_err(BenchError::iox("state publisher"))?;
+        let listener = msgs::open::wake(node, run, id, limits)
+            .map_err(BenchError::iox_msg("wake"))?
+            .listener_builder()
+            .create()
+            .map_err(BenchError::iox("wake listener"))?;
+        let mut subs = Vec::new();
+        let mut input_services = Vec::new();
+        for &j in inputs {
+            let svc =
+                msgs::open::state(node, run, j, limits).map_err(BenchError::iox_msg("state"))?;
+            subs.push(
+                svc.subscriber_builder()
+                    .buffer_size(limits.state_buffer)
+                    .create()
+                    .map_err(BenchError::iox("state subscriber"))?,
+            );
+            input_services.push(svc);
+        }
+        let notifiers = outputs
+            .iter()
+            .map(|&j| {
+                msgs::open::wake(node, run, j, limits)
+                    .map_err(BenchError::iox_msg("wake"))?
+                    .notifier_builder()
+                    .create()
+                    .map_err(BenchError::iox("wake notifier"))
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Self {
+            own,
+            publisher,
+            listener,
+            subs,
+            input_services,
+            notifiers,
+        })
+    }
+
+    /// Readiness (as in the runtime): every input has a publisher and our
+    /// state service has `receivers` subscribers; then the subscribers are
+    /// attached to their publishers (as the runtime does before `Ready`).
+    fn wait_ready(&self, receivers: usize, barrier: Duration) -> Result<()> {
+        poll_until(
+            barrier,
+            || {
+                format!(
+                    "connections (receivers {}/{receivers})",
+                    self.own.dynamic_config().number_of_subscribers(),
+                )
+            },
+            || {
+                self.own.dynamic_config().number_of_subscribers() >= receivers
+                    && self
+                        .input_services
+                        .iter()
+                        .all(|s| s.dynamic_config().number_of_publishers() >= 1)
+            },
+        )?;
+        for sub in &self.subs {
+            sub.update_connections()
+                .map_err(BenchError::iox("connect input"))?;
+        }
+        Ok(())
+    }
+}
+
+/// The state a ring node publishes (identity attitude, zero rates).
+fn state(id: u32, n: u64, s: u32) -> StateMsg {
+    StateMsg {
+        version: PROTOCOL_VERSION,
+        sender: id,
+        step: n,
+        stage: s,
+        reserved: 0,
+        sent_unix_ns: 0,
+        r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        w: [0.0; 3],
+        s: [0.0; 3],
+    }
 }
 
 impl RingNode {
     /// The node's inputs and outputs.
-    fn topology(&self) -> Result<(Vec<u32>, Vec<u32>), String> {
+    fn topology(&self) -> Result<(Vec<u32>, Vec<u32>)> {
         let ring_mode = self.inputs.is_none() || self.outputs.is_none();
         if ring_mode && self.n < 3 {
-            return Err("a ring needs at least 3 nodes".into());
+            return Err(BenchError::Usage("a ring needs at least 3 nodes".into()));
         }
         if ring_mode && self.index >= self.n {
-            return Err(format!("index {} not below n = {}", self.index, self.n));
+            return Err(BenchError::Usage(format!(
+                "index {} not below n = {}",
+                self.index, self.n
+            )));
         }
         let ring = vec![
             (self.index + self.n - 1) % self.n,
@@ -205,7 +321,7 @@ impl RingNode {
     }
 
     /// Runs the node: connect, barriers, lockstep loop, finish barrier.
-    pub fn run(&self) -> Result<RingReport, String> {
+    pub fn run(&self) -> Result<RingReport> {
         let (inputs, outputs) = self.topology()?;
         let (run, id) = (self.run.as_str(), self.index);
         let limits = Limits {
@@ -214,133 +330,25 @@ impl RingNode {
             state_buffer: 64,
             telemetry_buffer: 256,
         };
-        let stage_timeout = Duration::from_secs_f64(self.stage_timeout);
         let barrier = Duration::from_secs_f64(self.barrier_timeout);
 
-        set_log_level(LogLevel::Error);
-        let cfg =
-            msgs::namespace::config(run, &self.root.join("iox")).map_err(|e| e.to_string())?;
-        let name = format!("ring_{id}");
-        let node = NodeBuilder::new()
-            .name(&name.as_str().try_into().map_err(port("node name"))?)
-            .config(&cfg)
-            .signal_handling_mode(SignalHandlingMode::Disabled)
-            .create::<ipc::Service>()
-            .map_err(port("iceoryx2 node"))?;
-
-        // Ports, opened exactly as the node runtime opens them.
-        let own = msgs::open::state(&node, run, id, &limits).map_err(|e| e.to_string())?;
-        let publisher = own
-            .publisher_builder()
-            .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
-            .set_backpressure_handler(retry_until(stage_timeout))
-            .create()
-            .map_err(port("state publisher"))?;
-        let listener = msgs::open::wake(&node, run, id, &limits)
-            .map_err(|e| e.to_string())?
-            .listener_builder()
-            .create()
-            .map_err(port("wake listener"))?;
-        let mut subs = Vec::new();
-        let mut input_services = Vec::new();
-        for &j in &inputs {
-            let svc = msgs::open::state(&node, run, j, &limits).map_err(|e| e.to_string())?;
-            subs.push(
-                svc.subscriber_builder()
-                    .buffer_size(limits.state_buffer)
-                    .create()
-                    .map_err(port("state subscriber"))?,
-            );
-            input_services.push(svc);
-        }
-        let notifiers = outputs
-            .iter()
-            .map(|&j| {
-                msgs::open::wake(&node, run, j, &limits)
-                    .map_err(|e| e.to_string())?
-                    .notifier_builder()
-                    .create()
-                    .map_err(port("wake notifier"))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-
-        // Readiness barrier (as in the runtime), then the start barrier.
-        poll_until(
-            barrier,
-            || {
-                format!(
-                    "connections (receivers {}/{})",
-                    own.dynamic_config().number_of_subscribers(),
-                    outputs.len()
-                )
-            },
-            || {
-                own.dynamic_config().number_of_subscribers() >= outputs.len()
-                    && input_services
-                        .iter()
-                        .all(|s| s.dynamic_config().number_of_publishers() >= 1)
-            },
+        let node = msgs::iox::create_node::<ipc::Service>(
+            run,
+            &self.root.join("iox"),
+            &format!("ring_{id}"),
         )?;
-        // Attach the subscribers to their publishers now rather than at the
-        // first receive (as the runtime does since it learnt to).
-        for sub in &subs {
-            sub.update_connections().map_err(port("connect input"))?;
-        }
+        let stage_timeout = Duration::from_secs_f64(self.stage_timeout);
+        let ports = Ports::open(&node, run, id, (&inputs, &outputs), &limits, stage_timeout)?;
+
+        // Readiness barrier, then the start barrier.
+        ports.wait_ready(outputs.len(), barrier)?;
         touch(&self.root.join(files::ready(id)))?;
         let start_file = self.root.join(files::START);
         poll_until(barrier, || "the start file".into(), || start_file.exists())?;
 
-        // Lockstep.
-        let mut waiter = Waiter::new(self.wait);
-        let notify = waiter.receivers_may_block();
         let start_unix = unix_now();
         let t0 = Instant::now();
-        for n in 0..self.steps {
-            for s in 0..4u32 {
-                publisher
-                    .send_copy(StateMsg {
-                        version: PROTOCOL_VERSION,
-                        sender: id,
-                        step: n,
-                        stage: s,
-                        reserved: 0,
-                        sent_unix_ns: 0,
-                        r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-                        w: [0.0; 3],
-                        s: [0.0; 3],
-                    })
-                    .map_err(port("state send"))?;
-                if notify {
-                    for nt in &notifiers {
-                        let _ = nt.notify();
-                    }
-                }
-                let deadline = Instant::now() + stage_timeout;
-                waiter.begin();
-                for (k, sub) in subs.iter().enumerate() {
-                    let msg = loop {
-                        if let Some(sample) = sub.receive().map_err(port("state receive"))? {
-                            break *sample;
-                        }
-                        if waiter.wait(&listener, deadline) {
-                            return Err(format!(
-                                "timed out after {} s waiting for node {}'s step {n} stage {s}",
-                                self.stage_timeout, inputs[k]
-                            ));
-                        }
-                    };
-                    if msg.version != PROTOCOL_VERSION
-                        || msg.sender != inputs[k]
-                        || (msg.step, msg.stage) != (n, s)
-                    {
-                        return Err(format!(
-                            "node {} sent sender {} step {} stage {} where step {n} stage {s} was due",
-                            inputs[k], msg.sender, msg.step, msg.stage
-                        ));
-                    }
-                }
-            }
-        }
+        self.lockstep(&ports, &inputs)?;
         let elapsed = t0.elapsed().as_secs_f64();
         let end_unix = unix_now();
 
@@ -363,6 +371,57 @@ impl RingNode {
             elapsed,
             peak_rss_kb: msgs::telemetry::peak_rss_kb(),
         })
+    }
+
+    /// The lockstep loop: per exchange, publish, notify the receivers (if
+    /// they may block), then take each input's message and check its stamp.
+    fn lockstep(&self, p: &Ports, inputs: &[u32]) -> Result<()> {
+        let id = self.index;
+        let stage_timeout = Duration::from_secs_f64(self.stage_timeout);
+        let mut waiter = Waiter::new(self.wait);
+        let notify = waiter.receivers_may_block();
+        for n in 0..self.steps {
+            for s in 0..4u32 {
+                p.publisher
+                    .send_copy(state(id, n, s))
+                    .map_err(BenchError::iox("state send"))?;
+                if notify {
+                    for nt in &p.notifiers {
+                        let _ = nt.notify();
+                    }
+                }
+                let deadline = Instant::now() + stage_timeout;
+                waiter.begin();
+                for (k, sub) in p.subs.iter().enumerate() {
+                    let msg = loop {
+                        if let Some(sample) =
+                            sub.receive().map_err(BenchError::iox("state receive"))?
+                        {
+                            break *sample;
+                        }
+                        if waiter.wait(&p.listener, deadline) {
+                            return Err(BenchError::Timeout {
+                                seconds: self.stage_timeout,
+                                what: format!(
+                                    "waiting for node {}'s step {n} stage {s}",
+                                    inputs[k]
+                                ),
+                            });
+                        }
+                    };
+                    if msg.version != PROTOCOL_VERSION
+                        || msg.sender != inputs[k]
+                        || (msg.step, msg.stage) != (n, s)
+                    {
+                        return Err(BenchError::Protocol(format!(
+                            "node {} sent sender {} step {} stage {} where step {n} stage {s} was due",
+                            inputs[k], msg.sender, msg.step, msg.stage
+                        )));
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 }
 

@@ -1,6 +1,18 @@
-//! Run outputs: `errors.csv`, `summary.json`, `errors.svg`, `scenario.toml`,
-//! written atomically (see [`staging`]).
+//! Run outputs: `errors.csv`, `summary.json`, `errors.svg`, `states.bin`
+//! (`scenario.toml` and `logs/` are written by the run driver), staged and
+//! renamed into place atomically.
+//!
+//! # Layout
+//! - [`layout`]: the name of every file and directory of a run and of a
+//!   sweep (`RunLayout`, `SweepLayout`, the staging directory's name).
+//! - this module: [`Recorder`] (snapshots → `errors.csv` rows and
+//!   [`Series`], and `states.bin`), [`agent_summaries`], [`write_summary`].
+//! - [`summary`]: `summary.json` ([`Summary`]) and the end-of-run table.
+//! - [`states`]: `states.bin`, its byte layout, reader and CSV export.
+//! - [`plot`]: draws `errors.svg`.
+//! - [`staging`]: the atomic results directory (`.NAME.partial-PID`).
 
+pub mod layout;
 pub mod plot;
 pub mod staging;
 pub mod states;
@@ -9,6 +21,7 @@ pub mod summary;
 use attitude::engine::Snapshot;
 use attitude::metrics::errors;
 use attitude::network::Network;
+pub use layout::{RunLayout, SweepLayout};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
@@ -59,8 +72,9 @@ pub fn fmt_time(step: u64, dt: f64) -> String {
 impl Recorder {
     /// Starts `errors.csv` and `states.bin` in `dir` for `net`.
     pub fn new(dir: &Path, scenario: &str, net: &Network) -> io::Result<Self> {
-        let states = states::StatesWriter::create(&dir.join("states.bin"), scenario, net)?;
-        let mut csv = BufWriter::new(File::create(dir.join("errors.csv"))?);
+        let files = RunLayout::new(dir);
+        let states = states::StatesWriter::create(&files.states(), scenario, net)?;
+        let mut csv = BufWriter::new(File::create(files.errors_csv())?);
         writeln!(csv, "{CSV_HEADER}")?;
         let has_observer = net
             .agents
@@ -143,5 +157,5 @@ pub fn agent_summaries(series: &[Series], peak_torques: &[f64]) -> Vec<AgentSumm
 /// Writes `summary.json`.
 pub fn write_summary(dir: &Path, summary: &Summary) -> io::Result<()> {
     let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
-    std::fs::write(dir.join(staging::MARKER), text + "\n")
+    std::fs::write(RunLayout::new(dir).summary(), text + "\n")
 }

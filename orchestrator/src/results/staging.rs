@@ -3,6 +3,7 @@
 //! complete. An interrupted process leaves at most a `.NAME.partial-PID`
 //! directory, never something that looks like finished results.
 
+use super::layout;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -18,7 +19,7 @@ pub struct Staging {
 
 /// The file that marks a directory as attsync results (so that only such a
 /// directory is ever replaced).
-pub const MARKER: &str = "summary.json";
+pub const MARKER: &str = layout::SUMMARY;
 
 impl Staging {
     /// Prepares a staging directory for `dest`. Fails if `dest` exists and is
@@ -33,17 +34,10 @@ impl Staging {
                 ),
             ));
         }
-        let name = dest
-            .file_name()
-            .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "output path has no name"))?
-            .to_string_lossy()
-            .into_owned();
-        let parent = dest
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        fs::create_dir_all(parent)?;
-        let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        let tmp = layout::staging_dir(dest, std::process::id()).ok_or_else(|| {
+            io::Error::new(io::ErrorKind::InvalidInput, "output path has no name")
+        })?;
+        fs::create_dir_all(tmp.parent().expect("beside dest"))?;
         if tmp.exists() {
             fs::remove_dir_all(&tmp)?;
         }
@@ -70,9 +64,8 @@ impl Staging {
     /// Moves the staging directory into place, replacing an earlier result.
     pub fn commit(mut self) -> io::Result<PathBuf> {
         if self.dest.exists() {
-            let old = self.tmp.with_file_name(format!(
-                "{}.old",
-                self.tmp.file_name().expect("named").to_string_lossy()
+            let old = self.tmp.with_file_name(layout::replaced_name(
+                &self.tmp.file_name().expect("named").to_string_lossy(),
             ));
             fs::rename(&self.dest, &old)?;
             fs::rename(&self.tmp, &self.dest)?;
@@ -110,7 +103,7 @@ mod tests {
         let dest = root.path().join("out");
         {
             let s = Staging::new(&dest).unwrap();
-            fs::write(s.path().join("errors.csv"), "x").unwrap();
+            fs::write(s.path().join(layout::ERRORS_CSV), "x").unwrap();
         }
         assert_eq!(fs::read_dir(root.path()).unwrap().count(), 0);
         let s = Staging::new(&dest).unwrap();

@@ -20,7 +20,7 @@
 use attitude::engine::Snapshot;
 use attitude::network::{AgentState, Network};
 use attitude::reference::LeaderState;
-use msgs::payload::to_rows;
+use msgs::to_rows;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Write};
@@ -91,6 +91,8 @@ pub struct Record {
     pub agents: Vec<AgentRecord>,
 }
 
+// NOTE: the row-major conversion is msgs' (`msgs::to_rows`, the one every
+// payload uses), so a matrix is laid out the same way on the wire and here.
 impl LeaderRecord {
     fn of(l: &LeaderState) -> Self {
         Self {
