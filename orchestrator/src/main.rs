@@ -126,6 +126,10 @@ enum Command {
         /// Where the candidate's output goes [default: a file in the temp directory].
         #[arg(long)]
         log: Option<PathBuf>,
+        /// Rule `law`: `builtin`, a departure from the built-in law fails;
+        /// `own` (a deliberately different controller), it is reported as INFO.
+        #[arg(long, value_enum, default_value_t = LawArg::Builtin)]
+        law: LawArg,
         /// The candidate program and its arguments (after `--`).
         #[arg(last = true, required = true, value_name = "COMMAND")]
         command: Vec<String>,
@@ -197,6 +201,14 @@ impl From<WaitArg> for WaitStrategy {
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
+enum LawArg {
+    /// The candidate must run the built-in law of its scheme.
+    Builtin,
+    /// It runs its own controller: a departure is information only.
+    Own,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
 enum SchemeArg {
     ObserverTimeVarying,
     ObserverConstant,
@@ -231,6 +243,7 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
             stage_timeout,
             start_timeout,
             log,
+            law,
             command,
         } => {
             let log = log.unwrap_or_else(|| {
@@ -244,6 +257,10 @@ fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
                 stage_timeout,
                 start_timeout,
                 log,
+                law: match law {
+                    LawArg::Builtin => attsync::conform::LawMode::Builtin,
+                    LawArg::Own => attsync::conform::LawMode::Own,
+                },
             };
             let report = attsync::conform::conform(&opts)?;
             println!("{}", report.table());
