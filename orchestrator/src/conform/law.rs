@@ -139,7 +139,9 @@ pub struct Deviation {
 #[derive(Debug, Clone, PartialEq, Eq, Error)]
 pub enum LawError {
     /// The record's exchange is not the one the schedule has next.
-    #[error("recorded exchange step {got_step} stage {got_stage} where step {step} stage {stage} was due")]
+    #[error(
+        "recorded exchange step {got_step} stage {got_stage} where step {step} stage {stage} was due"
+    )]
     OutOfSchedule {
         /// Recorded step.
         got_step: u64,
@@ -366,12 +368,14 @@ mod tests {
         inputs[0].w[0] = f64::NAN;
         let mut agent = Agent::new(model.clone(), initial, dt);
         let rec = record_of(&mut agent, schedule, &inputs);
-        let d = replay(&model, initial, dt, schedule, &rec).unwrap().unwrap();
+        let d = replay(&model, initial, dt, schedule, &rec)
+            .unwrap()
+            .unwrap();
         assert_eq!(d.value, 0.0, "{d:?}");
     }
 
     #[test]
-    fn a_wrong_sign_is_found_at_the_first_exchange_it_shows() {
+    fn a_wrong_sign_shows_in_omega() {
         let (model, initial, dt, schedule, inputs) = setup();
         let mut wrong = model.clone();
         if let Scheme::Observerless { control } = &mut wrong.scheme {
@@ -379,12 +383,11 @@ mod tests {
         }
         let mut agent = Agent::new(wrong, initial, dt);
         let rec = record_of(&mut agent, schedule, &inputs);
-        let d = replay(&model, initial, dt, schedule, &rec).unwrap().unwrap();
+        let d = replay(&model, initial, dt, schedule, &rec)
+            .unwrap()
+            .unwrap();
         assert!(d.value > 1e-4, "{d:?}");
-        assert!(
-            matches!(d.quantity, Quantity::W | Quantity::BodyW),
-            "{d:?}"
-        );
+        assert!(matches!(d.quantity, Quantity::W | Quantity::BodyW), "{d:?}");
     }
 
     #[test]

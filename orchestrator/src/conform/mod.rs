@@ -7,6 +7,8 @@
 //! between agents 1 and 3, hearing the leader); every node but the
 //! candidate runs in-process on attsync's own model, fed with what the
 //! candidate publishes, so the candidate is exercised in a real closed loop.
+//! Rule `law` ([`replay`]) then replays the inputs it was given through
+//! attsync's own agent and compares the states it published.
 
 mod harness;
 mod law;
