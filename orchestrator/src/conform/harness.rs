@@ -2,6 +2,7 @@
 //! neighbours of one candidate process, in lockstep.
 
 use super::ConformOptions;
+use super::law::{ExchangeRecord, LawRecord};
 use super::rules::{Report, RuleId};
 use crate::processes::namespace::Namespace;
 use crate::processes::{ProcessOptions, node_configs, supervise::tail};
@@ -250,6 +251,8 @@ struct TelemetryCheck {
     ready: bool,
     done: bool,
     problem: Option<String>,
+    /// Every sample received (rule `law`).
+    samples: Vec<(u64, attitude::network::AgentState)>,
 }
 
 impl TelemetryCheck {
@@ -264,6 +267,7 @@ impl TelemetryCheck {
             ready: false,
             done: false,
             problem: None,
+            samples: Vec::new(),
         }
     }
 
@@ -297,6 +301,7 @@ impl TelemetryCheck {
                         bad(format!("sample at step {step} after Done"));
                     }
                     self.seen.push(step);
+                    self.samples.push((step, state));
                 }
                 Ok(Telemetry::LeaderSample { step, .. }) => {
                     bad(format!("sends the leader's sample (step {step})"));
@@ -495,6 +500,7 @@ fn drive(
         RuleId::RefusesInvalid,
         RuleId::Telemetry,
         RuleId::Stops,
+        RuleId::Law,
     ];
     let skip_rest = |report: &mut Report, why: &str| {
         for r in later {
@@ -551,6 +557,7 @@ fn drive(
     let mut early: Option<StateMsg> = None;
     let mut after_nan = false;
     let mut last_cand: Option<Exchanged> = None;
+    let mut record = LawRecord::default();
     for n in 0..cfg.steps {
         for s in 0..4u32 {
             if !cfg.coupling.exchanges_at(n, s as usize) {
@@ -559,17 +566,21 @@ fn drive(
             }
             let withhold = Some((n, s)) == withhold_at;
             let publish = |hood: &Neighbourhood| {
+                let mut sent = Vec::with_capacity(cfg.inputs.len());
                 for (k, (&j, p)) in cfg.inputs.iter().zip(input_pubs).enumerate() {
                     let mut m = StateMsg::new(j, n, s, &hood.exchange_of(net, j));
                     if Some((n, s)) == nan_at && k == 0 {
                         m.w[0] = f64::NAN;
                     }
+                    sent.push(m.exchanged());
                     let _ = p.send_copy(m);
                 }
                 let _ = cand_wake.notify();
+                sent
             };
+            let mut delivered = Vec::new();
             if !withhold {
-                publish(&hood);
+                delivered = publish(&hood);
             }
             // The candidate's state of (n, s).
             let deadline = Instant::now() + stage_timeout;
@@ -660,11 +671,17 @@ fn drive(
                 } else {
                     report.pass(RuleId::WaitsForInputs);
                 }
-                publish(&hood);
+                delivered = publish(&hood);
             }
             if Some((n, s)) == nan_at {
                 after_nan = true;
             }
+            record.exchanges.push(ExchangeRecord {
+                step: n,
+                stage: s,
+                inputs: delivered,
+                published: msg.exchanged(),
+            });
             last_cand = cand.or(last_cand);
             hood.exchange(last_cand);
             hood.advance();
@@ -698,6 +715,8 @@ fn drive(
         Ok(()) => report.pass(RuleId::Telemetry),
         Err(why) => report.fail(RuleId::Telemetry, why),
     }
+    record.samples = std::mem::take(&mut tcheck.samples);
+    super::law::judge(cfg, &record, opts.law, report);
     if control
         .send_copy(ControlMsg::new(ControlCommand::Stop))
         .is_err()

@@ -7,10 +7,14 @@
 //! between agents 1 and 3, hearing the leader); every node but the
 //! candidate runs in-process on attsync's own model, fed with what the
 //! candidate publishes, so the candidate is exercised in a real closed loop.
+//! Rule `law` ([`replay`]) then replays the inputs it was given through
+//! attsync's own agent and compares the states it published.
 
 mod harness;
+mod law;
 mod rules;
 
+pub use law::{At, Deviation, ExchangeRecord, LawError, LawRecord, Quantity, TOLERANCE, replay};
 pub use rules::{Report, Rule, RuleId, Verdict};
 
 use crate::scenario::{self, Loaded};
@@ -36,6 +40,20 @@ pub struct ConformOptions {
     pub start_timeout: f64,
     /// Where the candidate's output goes.
     pub log: PathBuf,
+    /// What a departure from the built-in law is (rule `law`).
+    pub law: LawMode,
+}
+
+/// How rule `law` judges a candidate whose published states depart from
+/// the built-in law of its scheme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LawMode {
+    /// It must run the built-in law: a departure fails.
+    #[default]
+    Builtin,
+    /// It runs its own controller on purpose (e.g. `examples/saturated_agent`):
+    /// the departure is reported for information only.
+    Own,
 }
 
 /// The neighbourhood of `opts`.

@@ -24,11 +24,13 @@ pub enum RuleId {
     Stops,
     /// Leaves no iceoryx2 node and no process behind.
     Clean,
+    /// Publishes what the built-in law of its scheme computes from its inputs.
+    Law,
 }
 
 impl RuleId {
     /// Every rule, in report order.
-    pub const ALL: [RuleId; 9] = [
+    pub const ALL: [RuleId; 10] = [
         RuleId::Version,
         RuleId::Connects,
         RuleId::InOrder,
@@ -38,6 +40,7 @@ impl RuleId {
         RuleId::Telemetry,
         RuleId::Stops,
         RuleId::Clean,
+        RuleId::Law,
     ];
 
     /// Short name (as in PROTOCOL.md).
@@ -53,6 +56,7 @@ impl RuleId {
             RuleId::Telemetry => "telemetry",
             RuleId::Stops => "stops",
             RuleId::Clean => "clean",
+            RuleId::Law => "law",
         }
     }
 
@@ -69,6 +73,7 @@ impl RuleId {
             RuleId::Telemetry => "reports samples at the due steps, then Done",
             RuleId::Stops => "exits with status 0 when told to stop",
             RuleId::Clean => "leaves no iceoryx2 node and no process behind",
+            RuleId::Law => "publishes what the built-in law computes from its inputs",
         }
     }
 }
@@ -82,6 +87,17 @@ pub enum Verdict {
     Fail(String),
     /// It could not be checked, because… (counts as a failure).
     NotChecked(String),
+    /// For information only (does not fail the run): the candidate
+    /// deliberately departs from the rule, and by how much.
+    Info(String),
+}
+
+impl Verdict {
+    /// Whether the verdict lets the run pass (`Pass` or `Info`).
+    #[must_use]
+    pub fn ok(&self) -> bool {
+        matches!(self, Verdict::Pass | Verdict::Info(_))
+    }
 }
 
 /// A rule and its outcome.
@@ -141,6 +157,15 @@ impl Report {
         }
     }
 
+    /// Records a departure for information only, unless already decided
+    /// otherwise (a failure is kept).
+    pub fn info(&mut self, id: RuleId, why: impl Into<String>) {
+        let r = self.rule(id);
+        if !matches!(r.verdict, Verdict::Fail(_)) {
+            r.verdict = Verdict::Info(why.into());
+        }
+    }
+
     /// Marks a rule as not checkable, unless already decided.
     pub fn not_checked(&mut self, id: RuleId, why: impl Into<String>) {
         let r = self.rule(id);
@@ -160,10 +185,10 @@ impl Report {
             .verdict
     }
 
-    /// Whether every rule passed.
+    /// Whether every rule passed (or was reported for information only).
     #[must_use]
     pub fn passed(&self) -> bool {
-        self.rules.iter().all(|r| r.verdict == Verdict::Pass)
+        self.rules.iter().all(|r| r.verdict.ok())
     }
 
     /// One line per rule.
@@ -175,18 +200,22 @@ impl Report {
                 Verdict::Pass => ("PASS", String::new()),
                 Verdict::Fail(w) => ("FAIL", format!("\n       {w}")),
                 Verdict::NotChecked(w) => ("SKIP", format!("\n       not checked: {w}")),
+                Verdict::Info(w) => ("INFO", format!("\n       for information: {w}")),
             };
             let _ = writeln!(s, "{tag}  {:<17} {}{why}", r.id.name(), r.id.text());
         }
-        let n_pass = self
-            .rules
-            .iter()
-            .filter(|r| r.verdict == Verdict::Pass)
-            .count();
+        let count = |f: fn(&Verdict) -> bool| self.rules.iter().filter(|r| f(&r.verdict)).count();
+        let n_pass = count(|v| *v == Verdict::Pass);
+        let n_info = count(|v| matches!(v, Verdict::Info(_)));
+        let info = match n_info {
+            0 => String::new(),
+            n => format!(", {n} for information only"),
+        };
+        // An INFO rule is not judged: it counts in neither figure.
         let _ = write!(
             s,
-            "{n_pass}/{} rules pass; the candidate's output: {}",
-            self.rules.len(),
+            "{n_pass}/{} rules pass{info}; the candidate's output: {}",
+            self.rules.len() - n_info,
             self.log.display()
         );
         s

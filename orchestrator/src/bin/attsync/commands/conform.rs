@@ -2,7 +2,7 @@
 
 use super::SetArgs;
 use attsync::Error;
-use attsync::conform::{self, ConformOptions};
+use attsync::conform::{self, ConformOptions, LawMode};
 use std::path::PathBuf;
 
 /// `attsync conform [--scenario F] [--agent ID] [--set K=V]… -- COMMAND…`.
@@ -23,12 +23,26 @@ pub struct Conform {
     /// Longest wait for the candidate to connect, s.
     #[arg(long, default_value_t = 20.0)]
     pub start_timeout: f64,
+    /// Whose law the `law` rule holds the candidate to: `builtin` (a
+    /// deviation from the built-in law of the scheme fails) or `own` (a
+    /// deliberately different controller: the deviation is reported as INFO).
+    #[arg(long, value_enum, default_value_t = LawArg::Builtin)]
+    pub law: LawArg,
     /// Where the candidate's output goes [default: a file in the temp directory].
     #[arg(long)]
     pub log: Option<PathBuf>,
     /// The candidate program and its arguments (after `--`).
     #[arg(last = true, required = true, value_name = "COMMAND")]
     pub command: Vec<String>,
+}
+
+/// `--law`.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum LawArg {
+    /// The built-in law of the configured scheme.
+    Builtin,
+    /// The candidate's own law (deviations are INFO).
+    Own,
 }
 
 /// Checks the candidate and prints one verdict per rule; fails unless every
@@ -45,6 +59,10 @@ pub fn exec(a: Conform) -> Result<(), Error> {
         stage_timeout: a.stage_timeout,
         start_timeout: a.start_timeout,
         log,
+        law: match a.law {
+            LawArg::Builtin => LawMode::Builtin,
+            LawArg::Own => LawMode::Own,
+        },
     };
     attsync::options::conform(&opts)?;
     let loaded = conform::neighbourhood(&opts)?;
