@@ -1,6 +1,7 @@
 //! `attsync run`: a loaded scenario through an engine into a results
 //! directory.
 
+use crate::outcome::Outcome;
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::results::{self, Recorder, Summary, plot, staging::Staging};
 use crate::scenario::Loaded;
@@ -107,7 +108,7 @@ pub fn run(
         bar.set_position(snap.step);
         true
     };
-    let (peaks, steps, failure, links, pacing, nodes) = match opts.engine {
+    let outcome = match opts.engine {
         Engine::InProcess => {
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
@@ -118,39 +119,20 @@ pub fn run(
                 }
                 record(snap)
             });
-            let peaks = engine.agents().iter().map(|a| a.peak_torque()).collect();
-            let mut links: Vec<(u32, u32, attitude::link::LinkStats)> = engine
-                .agents()
-                .iter()
-                .flat_map(|a| {
-                    let to = a.model().id;
-                    a.link_stats()
-                        .into_iter()
-                        .map(move |(from, st)| (from, to, st))
-                })
-                .collect();
-            links.sort_by_key(|&(f, t, _)| (f, t));
-            (
-                peaks,
-                engine.step_index(),
-                interrupted.then(|| "interrupted".to_string()),
-                links,
-                Vec::new(),
-                Vec::new(),
-            )
+            Outcome::in_process(&engine, interrupted)
         }
         Engine::Processes => {
-            let out = processes::run(net, &process_opts, &dir.join("logs"), interrupt, record)?;
-            (
-                out.peak_torques,
-                out.steps,
-                out.failure,
-                out.links,
-                out.pacing,
-                out.nodes,
-            )
+            processes::run(net, &process_opts, &dir.join("logs"), interrupt, record)?
         }
     };
+    let Outcome {
+        peak_torques: peaks,
+        steps,
+        failure,
+        links,
+        pacing,
+        nodes,
+    } = outcome;
     let wall_seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
     if let Some(e) = write_error {
