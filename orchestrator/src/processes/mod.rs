@@ -5,28 +5,28 @@
 //! removes everything the run created.
 //!
 //! [`run`] is a short sequence of phases, each in its own file: open the
-//! ports and start the nodes ([`startup`]), wait until every node is ready
-//! and send `Start` (also [`startup`]), collect telemetry into snapshots
-//! ([`collect`]), name the node to blame if the run failed ([`blame`]), and
-//! stop or kill the nodes ([`shutdown`]).
+//! ports and start the nodes (`startup`), wait until every node is ready
+//! and send `Start` (also `startup`), collect telemetry into snapshots
+//! (`collect`), name the node to blame if the run failed (`blame`), and
+//! stop or kill the nodes (`shutdown`).
 //!
 //! # Layout
-//! - [`configs`]: each node's configuration and its name in messages.
+//! - `configs`: each node's configuration and its name in messages.
 //! - [`ports`]: the orchestrator's iceoryx2 ports of a run ([`Ports`]), also used by `conform`.
-//! - [`startup`]: spawning the nodes, the wait for `Ready`, `Start`.
-//! - [`collect`]: per-node bookkeeping (one `NodeSlot` per node), telemetry into snapshots.
-//! - [`blame`]: which node made the run fail, and why.
-//! - [`shutdown`]: `Stop` and the exits, or killing every node.
+//! - `startup`: spawning the nodes, the wait for `Ready`, `Start`.
+//! - `collect`: per-node bookkeeping (one `NodeSlot` per node), telemetry into snapshots.
+//! - `blame`: which node made the run fail, and why.
+//! - `shutdown`: `Stop` and the exits, or killing every node.
 //! - [`supervise`]: the node processes (tokio): spawn, exits, kill.
 //! - [`namespace`]: a run's iceoryx2 namespace on this machine.
 
-pub mod blame;
-pub mod collect;
-pub mod configs;
+mod blame;
+mod collect;
+mod configs;
 pub mod namespace;
 pub mod ports;
-pub mod shutdown;
-pub mod startup;
+mod shutdown;
+mod startup;
 pub mod supervise;
 
 pub use configs::node_configs;
