@@ -4,8 +4,8 @@
 //! - [`scenario`]: the TOML format, `--set` overrides, validation, resolution
 //!   into the model's [`attitude::network::Network`].
 //! - [`run`]: engines and the run driver (progress, interruption).
-//! - [`processes`]: the process-per-node engine (namespace, supervision,
-//!   telemetry).
+//! - [`outcome`]: how a run ended, the same [`outcome::Outcome`] from either engine.
+//! - [`processes`]: the process-per-agent engine, phase by phase; the orchestrator's ports.
 //! - [`results`]: `errors.csv`, `summary.json`, `errors.svg`, atomic output.
 //! - [`sweep`]: one field over many values, and the bisection for the margin.
 //! - [`generate`]: generated scenarios (random trees).
@@ -22,6 +22,7 @@ pub mod error;
 pub mod generate;
 pub mod interrupt;
 pub mod options;
+pub mod outcome;
 pub mod processes;
 pub mod results;
 pub mod run;

@@ -3,6 +3,7 @@
 
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
+use crate::outcome::Outcome;
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::results::{self, Recorder, Summary, plot, staging::Staging};
 use crate::scenario::Loaded;
@@ -127,7 +128,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
         bar.set_position(snap.step);
         true
     };
-    let (peaks, steps, failure, links, pacing, nodes) = match opts.engine {
+    let outcome = match opts.engine {
         Engine::InProcess => {
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
@@ -138,47 +139,26 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
                 }
                 record(snap)
             });
-            let peaks = engine.agents().iter().map(|a| a.peak_torque()).collect();
-            let mut links: Vec<(u32, u32, attitude::link::LinkStats)> = engine
-                .agents()
-                .iter()
-                .flat_map(|a| {
-                    let to = a.model().id;
-                    a.link_stats()
-                        .into_iter()
-                        .map(move |(from, st)| (from, to, st))
-                })
-                .collect();
-            links.sort_by_key(|&(f, t, _)| (f, t));
-            (
-                peaks,
-                engine.step_index(),
-                interrupted.then(|| interrupted_reason(interrupt)),
-                links,
-                Vec::new(),
-                Vec::new(),
-            )
+            Outcome::in_process(&engine, interrupted)
         }
         Engine::Processes => {
             let logs = dir.join("logs");
-            let out = processes::run(net, &process_opts, &logs, interrupt.flag(), record)?;
-            // The engine stopped for the interrupt: say which signal.
-            let failure = out.failure.map(|f| match f.strip_suffix("interrupted") {
-                Some(blame) if interrupt.is_set() => {
-                    blame.to_owned() + &interrupted_reason(interrupt)
-                }
-                _ => f,
-            });
-            (
-                out.peak_torques,
-                out.steps,
-                failure,
-                out.links,
-                out.pacing,
-                out.nodes,
-            )
+            processes::run(net, &process_opts, &logs, interrupt.flag(), record)?
         }
     };
+    // An engine stopped by the interrupt says "interrupted": say which signal.
+    let failure = outcome.failure.map(|f| match f.strip_suffix("interrupted") {
+        Some(blame) if interrupt.is_set() => blame.to_owned() + &interrupted_reason(interrupt),
+        _ => f,
+    });
+    let Outcome {
+        peak_torques: peaks,
+        steps,
+        links,
+        pacing,
+        nodes,
+        ..
+    } = outcome;
     let wall_seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
     if let Some(e) = write_error {

@@ -10,10 +10,18 @@
 //! Rule `law` ([`replay`]) then replays the inputs it was given through
 //! attsync's own agent and compares the states it published.
 
+mod candidate;
+mod error;
 mod harness;
 mod law;
+mod lockstep;
+mod neighbourhood;
+mod probe;
 mod rules;
+mod telemetry_check;
+mod wires;
 
+pub use error::ConformError;
 pub use law::{At, Deviation, ExchangeRecord, LawError, LawRecord, Quantity, TOLERANCE, replay};
 pub use rules::{Report, Rule, RuleId, Verdict};
 
@@ -69,18 +77,17 @@ pub fn neighbourhood(opts: &ConformOptions) -> Result<Loaded, scenario::Scenario
 }
 
 /// Runs every check; errors only if the harness itself cannot run.
-pub fn conform(opts: &ConformOptions) -> anyhow::Result<Report> {
+pub fn conform(opts: &ConformOptions) -> Result<Report, ConformError> {
     let loaded = neighbourhood(opts)?;
     let net = &loaded.resolved.network;
     let Some(index) = net.index_of(opts.agent) else {
-        anyhow::bail!(
-            "agent {} is not in the neighbourhood {}",
-            opts.agent,
-            loaded.file.display()
-        );
+        return Err(ConformError::NotInNeighbourhood {
+            agent: opts.agent,
+            file: loaded.file.clone(),
+        });
     };
     let mut report = Report::new(opts.log.clone());
-    harness::version_probe(net, index, opts, &mut report)?;
+    probe::version_probe(net, index, opts, &mut report)?;
     harness::session(net, index, opts, &mut report)?;
     Ok(report)
 }

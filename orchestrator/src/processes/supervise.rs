@@ -1,6 +1,9 @@
 //! Process supervision with tokio: start the node processes (each in its own
 //! process group, output to its log file), report every exit as soon as it
-//! happens, kill them all on demand.
+//! happens, kill them all on demand. The engine polls it ([`Supervisor::try_exit`]);
+//! `conform` waits on it ([`Supervisor::next_exit`]) and keeps a candidate's
+//! process group after it exits, to check it is empty ([`Supervisor::keep_groups`],
+//! [`group_members`]).
 
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
@@ -16,6 +19,8 @@ pub struct Exit {
     pub index: usize,
     /// How it ended (or why it could not start).
     pub status: Result<ExitStatus, String>,
+    /// Its process group (the id of the process), if it started.
+    pub pgid: Option<u32>,
 }
 
 /// Describes an exit status: `exit code 1`, `killed by signal 9 (SIGKILL)`.
@@ -52,6 +57,8 @@ pub struct Supervisor {
     exits: mpsc::Receiver<Exit>,
     started: usize,
     ended: usize,
+    /// Leave a node's process group alone when the node exits.
+    keep_groups: bool,
 }
 
 impl Supervisor {
@@ -70,11 +77,22 @@ impl Supervisor {
             exits,
             started: 0,
             ended: 0,
+            keep_groups: false,
         })
     }
 
+    /// Leaves the process group of a node that exits by itself alone (by
+    /// default whatever it started is killed with it); [`Self::kill_all`]
+    /// still kills the groups.
+    #[must_use]
+    pub fn keep_groups(mut self) -> Self {
+        self.keep_groups = true;
+        self
+    }
+
     /// Starts `program args…` as node `index` (with `env` added to the
-    /// environment, in `cwd` if given), stdout and stderr to `log`.
+    /// environment, in `cwd` if given), stdout and stderr to `log`. Returns
+    /// its process id, or `None` if it could not start (its [`Exit`] says why).
     pub fn spawn(
         &mut self,
         index: usize,
@@ -83,7 +101,7 @@ impl Supervisor {
         env: &[(String, String)],
         cwd: Option<&Path>,
         log: &Path,
-    ) -> std::io::Result<()> {
+    ) -> std::io::Result<Option<u32>> {
         let out = std::fs::File::create(log)?;
         let err = out.try_clone()?;
         let mut cmd = tokio::process::Command::new(program);
@@ -102,6 +120,8 @@ impl Supervisor {
         self.started += 1;
         let _guard = self.rt.enter();
         let spawned = cmd.spawn();
+        let pid = spawned.as_ref().ok().and_then(tokio::process::Child::id);
+        let keep_groups = self.keep_groups;
         self.rt.spawn(async move {
             let mut child = match spawned {
                 Ok(c) => c,
@@ -109,32 +129,45 @@ impl Supervisor {
                     let _ = tx.send(Exit {
                         index,
                         status: Err(e.to_string()),
+                        pgid: None,
                     });
                     return;
                 }
             };
             let pgid = child.id();
+            let mut killed = false;
             let status = tokio::select! {
                 s = child.wait() => s,
                 _ = async { let _ = kill.wait_for(|k| *k).await.map(|_| ()); } => {
+                    killed = true;
                     let _ = child.start_kill();
                     kill_group(pgid);
                     child.wait().await
                 }
             };
             // Whatever the node started (a plug-in's own children) ends with it.
-            kill_group(pgid);
+            if killed || !keep_groups {
+                kill_group(pgid);
+            }
             let _ = tx.send(Exit {
                 index,
                 status: status.map_err(|e| e.to_string()),
+                pgid,
             });
         });
-        Ok(())
+        Ok(pid)
     }
 
     /// An exit that happened since the last call, if any.
     pub fn try_exit(&mut self) -> Option<Exit> {
         let e = self.exits.try_recv().ok()?;
+        self.ended += 1;
+        Some(e)
+    }
+
+    /// The next exit, waiting up to `timeout` for one.
+    pub fn next_exit(&mut self, timeout: Duration) -> Option<Exit> {
+        let e = self.exits.recv_timeout(timeout).ok()?;
         self.ended += 1;
         Some(e)
     }
@@ -185,13 +218,36 @@ impl Drop for Supervisor {
 }
 
 /// SIGKILL to the process group led by `pgid` (each node leads its own).
-fn kill_group(pgid: Option<u32>) {
+pub fn kill_group(pgid: Option<u32>) {
     if let Some(pid) = pgid.and_then(|p| i32::try_from(p).ok()) {
         let _ = nix::sys::signal::killpg(
             nix::unistd::Pid::from_raw(pid),
             nix::sys::signal::Signal::SIGKILL,
         );
     }
+}
+
+/// Processes of process group `pgid` still alive (read from /proc).
+#[must_use]
+pub fn group_members(pgid: u32) -> Vec<u32> {
+    let Ok(dir) = std::fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    dir.filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        .filter(|pid| {
+            std::fs::read_to_string(format!("/proc/{pid}/stat"))
+                .ok()
+                .and_then(|s| {
+                    // Fields after the command name (which may hold spaces): state ppid pgrp …
+                    let rest = &s[s.rfind(')')? + 2..];
+                    let mut f = rest.split_whitespace();
+                    let state = f.next()?;
+                    let pgrp = f.nth(1)?.parse::<u32>().ok()?;
+                    Some(pgrp == pgid && state != "Z")
+                })
+                .unwrap_or(false)
+        })
+        .collect()
 }
 
 /// The last `n` lines of a log file (empty if unreadable).

@@ -1,0 +1,114 @@
+//! Rule `telemetry`: the candidate's reports, checked as they come — its own
+//! sender id, decodable, samples finite and at the due steps, then `Done`.
+
+use crate::processes::Ports;
+use msgs::Telemetry;
+use msgs::config::NodeConfig;
+
+/// Checks of the candidate's telemetry.
+pub(super) struct TelemetryCheck {
+    /// Steps of the samples due.
+    expected: Vec<u64>,
+    /// Steps of the samples received.
+    seen: Vec<u64>,
+    /// It reported `Ready`.
+    pub(super) ready: bool,
+    /// It reported `Done`.
+    pub(super) done: bool,
+    /// The first thing wrong with its telemetry.
+    problem: Option<String>,
+    /// Every sample received (rule `law`).
+    pub(super) samples: Vec<(u64, attitude::network::AgentState)>,
+}
+
+impl TelemetryCheck {
+    /// Expects what `cfg` asks for.
+    pub(super) fn new(cfg: &NodeConfig) -> Self {
+        let mut expected: Vec<u64> = (0..=cfg.steps).step_by(cfg.sample_every as usize).collect();
+        if expected.last() != Some(&cfg.steps) {
+            expected.push(cfg.steps);
+        }
+        Self {
+            expected,
+            seen: Vec::new(),
+            ready: false,
+            done: false,
+            problem: None,
+            samples: Vec::new(),
+        }
+    }
+
+    /// Reads and checks every message of the candidate's telemetry
+    /// (`ports`' only subscriber) available; `id`: its node id, `steps`: the run's.
+    pub(super) fn drain(&mut self, ports: &Ports, id: u32, steps: u64) {
+        while let Ok(Some(m)) = ports.receive(0) {
+            let mut bad = |why: String| {
+                if self.problem.is_none() {
+                    self.problem = Some(why);
+                }
+            };
+            if m.sender != id {
+                bad(format!(
+                    "telemetry claims sender {}, expected {id}",
+                    m.sender
+                ));
+            }
+            match m.decode() {
+                Err(e) => bad(format!("telemetry: {e}")),
+                Ok(Telemetry::Ready) => self.ready = true,
+                Ok(Telemetry::Sample { step, state, .. }) => {
+                    let finite = state.r.iter().chain(state.w.iter()).all(|v| v.is_finite());
+                    if !finite
+                        || attitude::so3::orthogonality_defect(&state.r) > msgs::ROTATION_TOLERANCE
+                    {
+                        bad(format!(
+                            "sample at step {step} is not finite or R is not a rotation"
+                        ));
+                    }
+                    if self.done {
+                        bad(format!("sample at step {step} after Done"));
+                    }
+                    self.seen.push(step);
+                    self.samples.push((step, state));
+                }
+                Ok(Telemetry::LeaderSample { step, .. }) => {
+                    bad(format!("sends the leader's sample (step {step})"));
+                }
+                Ok(Telemetry::Done(d)) => {
+                    if d.steps != steps {
+                        bad(format!("Done carries step {}, expected {steps}", d.steps));
+                    }
+                    self.done = true;
+                }
+                Ok(Telemetry::LinkStats { .. } | Telemetry::Failed(_)) => {}
+            }
+        }
+    }
+
+    /// Rule `telemetry`'s verdict: the first problem seen, else missing samples or `Done`.
+    pub(super) fn verdict(&self) -> Result<(), String> {
+        if let Some(p) = &self.problem {
+            return Err(p.clone());
+        }
+        if self.seen != self.expected {
+            let first = self
+                .seen
+                .iter()
+                .zip(&self.expected)
+                .position(|(a, b)| a != b)
+                .unwrap_or(self.seen.len().min(self.expected.len()));
+            return Err(format!(
+                "samples at steps {:?}… (from the {}th) where {:?}… were due ({} of {} received)",
+                &self.seen[first.min(self.seen.len())..self.seen.len().min(first + 3)],
+                first + 1,
+                &self.expected[first.min(self.expected.len())..self.expected.len().min(first + 3)],
+                self.seen.len(),
+                self.expected.len()
+            ));
+        }
+        if !self.done {
+            return Err("no Done after the last step".into());
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,51 @@
+//! How a run ended, whichever engine ran it: one [`Outcome`] from the
+//! process engine ([`crate::processes::run`]) or the in-process engine
+//! ([`Outcome::in_process`]).
+
+use attitude::engine::InProcess;
+use attitude::link::LinkStats;
+use msgs::Done;
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// Peak torque per agent (network order), N·m; 0 where never reported.
+    pub peak_torques: Vec<f64>,
+    /// Steps of the last complete snapshot.
+    pub steps: u64,
+    /// Why the run stopped early, if it did.
+    pub failure: Option<String>,
+    /// Counters of the impaired links: (from, to, stats), by (from, to).
+    pub links: Vec<(u32, u32, LinkStats)>,
+    /// Real-time pacing per agent (network order): (stages started more
+    /// than a step late, largest lateness in wall s). Empty in-process.
+    pub pacing: Vec<(u64, f64)>,
+    /// What each node that finished reported with `Done`: (name, id,
+    /// report). Empty in-process.
+    pub nodes: Vec<(String, u32, Done)>,
+}
+
+impl Outcome {
+    /// The outcome of in-process `engine` as it stands (`interrupted`: it was
+    /// stopped by an interrupt).
+    #[must_use]
+    pub fn in_process(engine: &InProcess, interrupted: bool) -> Self {
+        let agents = engine.agents();
+        let mut links: Vec<(u32, u32, LinkStats)> = agents
+            .iter()
+            .flat_map(|a| {
+                let to = a.model().id;
+                (a.link_stats().into_iter()).map(move |(from, st)| (from, to, st))
+            })
+            .collect();
+        links.sort_by_key(|&(f, t, _)| (f, t));
+        Self {
+            peak_torques: agents.iter().map(|a| a.peak_torque()).collect(),
+            steps: engine.step_index(),
+            failure: interrupted.then(|| "interrupted".to_string()),
+            links,
+            pacing: Vec::new(),
+            nodes: Vec::new(),
+        }
+    }
+}

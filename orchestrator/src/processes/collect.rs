@@ -1,0 +1,291 @@
+//! Telemetry collection: one [`NodeSlot`] per node (what it reported so
+//! far), every message checked and booked, samples joined into the same
+//! snapshots the in-process engine produces ([`Session::collect`]).
+
+use super::startup::POLL;
+use super::{Failure, Ports, Session};
+use crate::outcome::Outcome;
+use attitude::engine::Snapshot;
+use attitude::link::LinkStats;
+use attitude::network::AgentState;
+use attitude::reference::LeaderState;
+use msgs::{Done, FailReason, Telemetry, TelemetryMsg};
+use std::collections::VecDeque;
+use std::time::{Duration, Instant};
+
+/// A decoded sample waiting for the rest of its snapshot.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Sampled {
+    /// The leader's.
+    Leader(LeaderState),
+    /// An agent's.
+    Agent(AgentState),
+}
+
+/// What the orchestrator knows of one node (its telemetry subscriber is the
+/// [`Ports`] subscriber of the same index).
+#[derive(Debug, Clone)]
+pub(crate) struct NodeSlot {
+    /// `leader`, `agent-<id>`: its log's name.
+    pub name: String,
+    /// Its name in messages (a plug-in's says so).
+    pub label: String,
+    /// Its node id: the only sender its telemetry may carry.
+    pub id: u32,
+    /// Samples not yet in a snapshot: (step, sample).
+    pub pending: VecDeque<(u64, Sampled)>,
+    /// It reported `Ready`.
+    pub ready: bool,
+    /// It reported `Done`.
+    pub done: bool,
+    /// Largest torque it reported, N·m.
+    pub peak_torque: f64,
+    /// Its `Done` report, once it came.
+    pub report: Option<Done>,
+    /// It reported giving up.
+    pub gave_up: bool,
+}
+
+impl NodeSlot {
+    /// A node that has reported nothing yet.
+    pub(crate) fn new(name: String, label: String, id: u32) -> Self {
+        Self {
+            name,
+            label,
+            id,
+            pending: VecDeque::new(),
+            ready: false,
+            done: false,
+            peak_torque: 0.0,
+            report: None,
+            gave_up: false,
+        }
+    }
+}
+
+/// Telemetry bookkeeping of every node (index 0 the leader, then agents in
+/// network order).
+#[derive(Debug)]
+pub(crate) struct Collector {
+    /// One per node.
+    pub slots: Vec<NodeSlot>,
+    /// Steps of the last complete snapshot.
+    pub steps: u64,
+    /// Counters of the impaired links: (from, to, stats).
+    pub links: Vec<(u32, u32, LinkStats)>,
+    /// (node index, id of the input it gave up waiting for), in arrival order.
+    pub blamed: Vec<(usize, u32)>,
+    /// Ids of nodes a receiver caught breaking the protocol.
+    pub broke_protocol: Vec<u32>,
+}
+
+impl Collector {
+    /// Bookkeeping for `slots`.
+    pub(crate) fn new(slots: Vec<NodeSlot>) -> Self {
+        Self {
+            slots,
+            steps: 0,
+            links: Vec::new(),
+            blamed: Vec::new(),
+            broke_protocol: Vec::new(),
+        }
+    }
+
+    /// Reads every telemetry message available; `Ok(true)` if any arrived.
+    pub(crate) fn drain(&mut self, ports: &Ports) -> Result<bool, Failure> {
+        let mut any = false;
+        for i in 0..self.slots.len() {
+            while let Some(m) = ports.receive(i).map_err(|e| e.to_string())? {
+                any = true;
+                self.accept(i, &m)?;
+            }
+        }
+        Ok(any)
+    }
+
+    /// Checks and books message `m` from node index `i`'s service: it must
+    /// carry that node's id and decode.
+    pub(crate) fn accept(&mut self, i: usize, m: &TelemetryMsg) -> Result<(), Failure> {
+        let slot = &self.slots[i];
+        if m.sender != slot.id {
+            return Err(format!(
+                "{} broke the protocol: its telemetry claims to come from node {}",
+                slot.label, m.sender
+            ));
+        }
+        let t = m
+            .decode()
+            .map_err(|e| format!("node {}'s telemetry: {e}", m.sender))?;
+        self.take(i, t);
+        Ok(())
+    }
+
+    /// Books report `t` of node index `i`.
+    fn take(&mut self, i: usize, t: Telemetry) {
+        let slot = &mut self.slots[i];
+        match t {
+            Telemetry::Ready => slot.ready = true,
+            Telemetry::Sample {
+                step,
+                state,
+                peak_torque,
+            } => {
+                slot.peak_torque = slot.peak_torque.max(peak_torque);
+                slot.pending.push_back((step, Sampled::Agent(state)));
+            }
+            Telemetry::LeaderSample { step, state } => {
+                slot.pending.push_back((step, Sampled::Leader(state)));
+            }
+            Telemetry::LinkStats { from, stats } => self.links.push((from, slot.id, stats)),
+            Telemetry::Done(d) => {
+                slot.done = true;
+                slot.peak_torque = d.peak_torque;
+                slot.report = Some(d);
+            }
+            Telemetry::Failed(reason) => {
+                slot.gave_up = true;
+                match reason {
+                    FailReason::InputTimeout { from } => self.blamed.push((i, from)),
+                    FailReason::BadInput { from } => {
+                        self.blamed.push((i, from));
+                        self.broke_protocol.push(from);
+                    }
+                    FailReason::Other => {}
+                }
+            }
+        }
+    }
+
+    /// Whether every node is done and every sample is in a snapshot.
+    fn finished(&self) -> bool {
+        (self.slots.iter()).all(|s| s.done && s.pending.is_empty())
+    }
+
+    /// The next complete snapshot, if every node has sent it.
+    fn next_snapshot(&mut self) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, Failure> {
+        if self.slots.iter().any(|s| s.pending.is_empty()) {
+            return Ok(None);
+        }
+        let step = self.slots[0].pending[0].0;
+        if let Some(s) = self.slots.iter().find(|s| s.pending[0].0 != step) {
+            return Err(format!(
+                "telemetry out of step: {} at step {}, leader at {step}",
+                s.name, s.pending[0].0
+            ));
+        }
+        let mut samples = (self.slots.iter_mut())
+            .map(|s| (s.name.as_str(), s.pending.pop_front().expect("non-empty").1));
+        let Some((_, Sampled::Leader(leader))) = samples.next() else {
+            return Err("the leader sent an agent's sample".into());
+        };
+        let agents = samples
+            .map(|(name, s)| match s {
+                Sampled::Agent(a) => Ok(a),
+                Sampled::Leader(_) => Err(format!("{name} sent the leader's sample")),
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Some((step, leader, agents)))
+    }
+
+    /// What the run produced, ending with `failure` (if it failed).
+    pub(crate) fn outcome(mut self, failure: Option<Failure>) -> Outcome {
+        self.links.sort_by_key(|&(f, t, _)| (f, t));
+        let agents = &self.slots[1..];
+        Outcome {
+            peak_torques: agents.iter().map(|s| s.peak_torque).collect(),
+            steps: self.steps,
+            failure,
+            pacing: (agents.iter())
+                .map(|s| {
+                    (s.report).map_or((0, 0.0), |d| (d.pacing.late_stages, d.pacing.max_lateness))
+                })
+                .collect(),
+            nodes: (self.slots.iter())
+                .filter_map(|s| s.report.map(|d| (s.name.clone(), s.id, d)))
+                .collect(),
+            links: self.links,
+        }
+    }
+}
+
+impl Session<'_> {
+    /// Collects telemetry into snapshots, handing each to `on_sample`, until
+    /// every node is done; fails when a node fails, on an interrupt, or when
+    /// no telemetry came for twice the stage timeout.
+    pub(super) fn collect(
+        &mut self,
+        on_sample: &mut impl FnMut(&Snapshot<'_>) -> bool,
+    ) -> Result<(), Failure> {
+        let stall = Duration::from_secs_f64(self.opts.stage_timeout * 2.0);
+        let mut last_progress = Instant::now();
+        loop {
+            self.ports.wait(POLL);
+            if self.nodes.drain(&self.ports)? {
+                last_progress = Instant::now();
+            }
+            while let Some((step, leader, agents)) = self.nodes.next_snapshot()? {
+                self.nodes.steps = step;
+                let snap = Snapshot {
+                    step,
+                    leader: &leader,
+                    agents: &agents,
+                };
+                if !on_sample(&snap) {
+                    return Err("stopped by the results writer".into());
+                }
+            }
+            if self.nodes.finished() {
+                return Ok(());
+            }
+            self.still_running()?;
+            if last_progress.elapsed() > stall {
+                return Err(format!(
+                    "no telemetry for {:.0} s: the run is stalled",
+                    stall.as_secs_f64()
+                ));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_nodes() -> Collector {
+        Collector::new(vec![
+            NodeSlot::new("leader".into(), "leader".into(), 0),
+            NodeSlot::new("agent-3".into(), "agent-3 (plug-in `x`)".into(), 3),
+        ])
+    }
+
+    #[test]
+    fn telemetry_from_a_false_sender_fails_naming_the_node() {
+        let mut c = two_nodes();
+        let m = TelemetryMsg::encode(7, &Telemetry::Ready);
+        let e = c.accept(1, &m).expect_err("a false sender");
+        assert!(
+            e.starts_with("agent-3 (plug-in `x`) broke the protocol"),
+            "{e}"
+        );
+        assert!(e.contains("node 7"), "{e}");
+        assert!(!c.slots[1].ready);
+    }
+
+    #[test]
+    fn telemetry_from_its_own_node_is_booked() {
+        let mut c = two_nodes();
+        c.accept(1, &TelemetryMsg::encode(3, &Telemetry::Ready))
+            .expect("its own id");
+        assert!(c.slots[1].ready && !c.slots[0].ready);
+    }
+
+    #[test]
+    fn undecodable_telemetry_fails_naming_the_node() {
+        let mut c = two_nodes();
+        let mut m = TelemetryMsg::encode(3, &Telemetry::Ready);
+        m.kind = 99;
+        let e = c.accept(1, &m).expect_err("an unknown kind");
+        assert!(e.starts_with("node 3's telemetry"), "{e}");
+    }
+}

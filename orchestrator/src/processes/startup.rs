@@ -1,0 +1,137 @@
+//! Start-up phases: open the ports, write each node's configuration and
+//! start its process ([`Session::open`], [`Session::spawn_nodes`]), wait
+//! until every node reports `Ready`, then send `Start`.
+
+use super::collect::{Collector, NodeSlot};
+use super::configs::{node_configs, node_id, node_label, node_name, plugin_of};
+use super::namespace::{self, Namespace};
+use super::supervise::{Supervisor, find_binaries};
+use super::{Failure, ProcessError, ProcessOptions, Session, io_at};
+use attitude::network::Network;
+use msgs::Limits;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Time between the orchestrator's `Start` and simulated time 0 in
+/// real-time mode, so that every node has read `Start` before it is due.
+const REALTIME_LEAD: Duration = Duration::from_millis(50);
+
+/// How long a phase waits for a node's wake-up before it looks around.
+pub(super) const POLL: Duration = Duration::from_millis(10);
+
+impl<'a> Session<'a> {
+    /// Creates the run's namespace and opens the orchestrator's ports.
+    pub(super) fn open(
+        net: &'a Network,
+        opts: &'a ProcessOptions,
+        logs: &'a Path,
+        interrupt: &'a AtomicBool,
+    ) -> Result<Self, ProcessError> {
+        let binaries = find_binaries().map_err(ProcessError::MissingBinary)?;
+        std::fs::create_dir_all(logs).map_err(io_at(logs))?;
+        let ns = Namespace::create().map_err(io_at(&namespace::base_dir()))?;
+        let n_nodes = net.agents.len() + 1;
+        let ids: Vec<u32> = (0..n_nodes).map(|i| node_id(net, i)).collect();
+        let ports = super::Ports::open(ns, "orchestrator", &Limits::of(net), &ids)?;
+        let sup = Supervisor::new().map_err(io_at(Path::new("tokio runtime")))?;
+        let slots = (0..n_nodes)
+            .map(|i| {
+                let label = node_label(net, &opts.plugins, i);
+                NodeSlot::new(node_name(net, i), label, ids[i])
+            })
+            .collect();
+        Ok(Self {
+            net,
+            opts,
+            logs,
+            interrupt,
+            binaries,
+            ports,
+            sup,
+            nodes: Collector::new(slots),
+        })
+    }
+
+    /// The log file of node index `i`.
+    pub(super) fn log_of(&self, i: usize) -> PathBuf {
+        self.logs.join(format!("{}.log", self.nodes.slots[i].name))
+    }
+
+    /// Writes every node's configuration and starts its process: a plug-in's
+    /// command in the scenario's directory, else the built-in binary.
+    pub(super) fn spawn_nodes(&mut self) -> Result<(), ProcessError> {
+        let (agent_bin, leader_bin) = self.binaries.clone();
+        let configs = node_configs(self.net, self.ports.run(), self.ports.dir(), self.opts);
+        for (i, c) in configs.iter().enumerate() {
+            let file = self.ports.dir().join(format!("node-{}.json", c.id));
+            c.write(&file).map_err(|e| ProcessError::Io {
+                path: file.clone(),
+                source: std::io::Error::other(e),
+            })?;
+            let file = file.to_string_lossy().into_owned();
+            let mut env = vec![("ATTSYNC_CONFIG".to_string(), file.clone())];
+            let config_arg = ["--config".to_string(), file];
+            let log = self.log_of(i);
+            let spawned = match plugin_of(self.net, &self.opts.plugins, i) {
+                Some(p) => {
+                    env.extend(p.env.iter().map(|(k, v)| (k.clone(), v.clone())));
+                    let args: Vec<String> =
+                        p.command[1..].iter().cloned().chain(config_arg).collect();
+                    let program = Path::new(&p.command[0]);
+                    self.sup.spawn(i, program, &args, &env, Some(&p.dir), &log)
+                }
+                None => {
+                    let bin = if i == 0 { &leader_bin } else { &agent_bin };
+                    self.sup.spawn(i, bin, &config_arg, &env, None, &log)
+                }
+            };
+            spawned.map_err(io_at(&log))?;
+        }
+        Ok(())
+    }
+
+    /// Waits until every node has reported `Ready`, at most the start timeout.
+    pub(super) fn await_ready(&mut self) -> Result<(), Failure> {
+        let deadline = Instant::now() + Duration::from_secs_f64(self.opts.start_timeout);
+        while !self.nodes.slots.iter().all(|s| s.ready) {
+            self.ports.wait(POLL);
+            self.nodes.drain(&self.ports)?;
+            self.still_running()?;
+            if Instant::now() > deadline {
+                let missing: Vec<&str> = (self.nodes.slots.iter())
+                    .filter(|s| !s.ready)
+                    .map(|s| s.label.as_str())
+                    .collect();
+                return Err(format!(
+                    "start-up timed out after {} s: not ready: {}",
+                    self.opts.start_timeout,
+                    missing.join(", ")
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Sends `Start` (in real-time mode: for a moment just ahead).
+    pub(super) fn start(&mut self) -> Result<(), Failure> {
+        let at = self
+            .opts
+            .realtime
+            .map(|_| msgs::unix_ns_now() + REALTIME_LEAD.as_nanos() as u64);
+        self.ports
+            .start(at)
+            .map_err(|_| "cannot send Start".to_string())
+    }
+
+    /// Fails if a node has ended before it was done, or on an interrupt.
+    pub(super) fn still_running(&mut self) -> Result<(), Failure> {
+        if let Some(f) = self.ended_early() {
+            return Err(f);
+        }
+        if self.interrupt.load(Ordering::Relaxed) {
+            return Err("interrupted".into());
+        }
+        Ok(())
+    }
+}
