@@ -17,20 +17,18 @@ mod lockstep;
 mod ports;
 mod realtime;
 
+pub use attitude::schedule::{Schedule, Slot};
 pub use hooks::{Hooks, NoHooks, Override};
 
 use attitude::link::LinkStats;
 use attitude::network::Exchanged;
+use hooks::Hooked;
 use iceoryx2::node::Node;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::open::OpenError;
 use msgs::telemetry::peak_rss_kb;
-use msgs::{
-    ControlCommand, Done, FailReason, PROTOCOL_VERSION, StateMsg, Telemetry,
-    unix_ns_now,
-};
-use hooks::Hooked;
+use msgs::{ControlCommand, Done, FailReason, PROTOCOL_VERSION, StateMsg, Telemetry, unix_ns_now};
 use ports::Ports;
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -374,7 +372,12 @@ fn wait_command<S: Service, H: Hooks>(
 ) -> Result<Option<(ControlCommand, u64)>, NodeError> {
     let deadline = Instant::now() + timeout;
     loop {
-        if let Some(sample) = io.ports.control.receive().map_err(port("control receive"))? {
+        if let Some(sample) = io
+            .ports
+            .control
+            .receive()
+            .map_err(port("control receive"))?
+        {
             if sample.version != PROTOCOL_VERSION {
                 return Err(NodeError::Protocol(format!(
                     "orchestrator speaks protocol version {}, this node {PROTOCOL_VERSION}",

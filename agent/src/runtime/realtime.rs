@@ -56,7 +56,8 @@ impl Clock {
 
     /// When `slot` is due.
     fn due(&self, slot: Slot) -> Instant {
-        self.t0 + Duration::from_secs_f64((slot.step as f64 + slot.time_fraction()) * self.step_wall)
+        self.t0
+            + Duration::from_secs_f64((slot.step as f64 + slot.time_fraction()) * self.step_wall)
     }
 }
 
@@ -192,7 +193,10 @@ fn exchange<S: Service, N: Stepper, H: Hooks>(
                     waited: cfg.stage_timeout,
                 });
             }
-            let _ = io.ports.listener.timed_wait(|_| {}, Duration::from_millis(1));
+            let _ = io
+                .ports
+                .listener
+                .timed_wait(|_| {}, Duration::from_millis(1));
         }
         if let Some((x, sent)) = fresh {
             stepper.receive(k, x);
