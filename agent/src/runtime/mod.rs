@@ -4,13 +4,23 @@
 //! 1. open every port; wait (bounded) until every receiver of our state, the
 //!    orchestrator's telemetry subscriber and the sender of every input are
 //!    connected; report `Ready`; wait (bounded) for `Start`;
-//! 2. step, either in deterministic lockstep (`lockstep.rs`, the default) or free
-//!    against the wall clock (`realtime.rs`);
+//! 2. step, walking the run's [`Schedule`] (stages, exchanges, stage
+//!    times), either in deterministic lockstep (`lockstep.rs`, the default)
+//!    or free against the wall clock (`realtime.rs`);
 //! 3. report the counters of the incoming links, then `Done`, and wait
 //!    (bounded) for `Stop`.
 //!
 //! Every received state is checked ([`StateMsg::validated`]); an invalid
 //! one is refused, counted and reported, and the node keeps the value it had.
+//! In every phase the node checks its parent at least every 100 ms and
+//! exits ([`NodeError::Orphaned`]) once the orchestrator is gone.
+//!
+//! # Layout
+//! - `ports.rs`: every iceoryx2 port and the readiness barrier.
+//! - `hooks.rs`: [`Hooks`], asked at every publish, receive, report and
+//!   command ([`run_with`]; [`run`] uses [`NoHooks`]).
+//! - `lockstep.rs`, `realtime.rs`: the two stepping loops.
+//! - here: [`Stepper`], [`NodeError`], the phases around the loops.
 
 mod hooks;
 mod lockstep;
