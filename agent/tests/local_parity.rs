@@ -29,7 +29,9 @@ type Samples = BTreeMap<(u64, u32), Vec<u64>>;
 
 fn agent_bits(s: &AgentState) -> Vec<u64> {
     let m = [&s.r, &s.r_hat].into_iter().flat_map(|m| m.iter());
-    let v = [&s.w, &s.w_hat, &s.s_hat].into_iter().flat_map(|v| v.iter());
+    let v = [&s.w, &s.w_hat, &s.s_hat]
+        .into_iter()
+        .flat_map(|v| v.iter());
     m.chain(v).map(|x| x.to_bits()).collect()
 }
 

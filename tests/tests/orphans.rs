@@ -74,7 +74,8 @@ fn nodes_exit_when_the_orchestrator_dies_while_they_connect() {
     let text = read(&paper("timevarying"));
     let anchor = "[[agent]]\nid = 3\n";
     let file = tmp.join("never-connects.toml");
-    let extra = "command = [\"sleep\", \"30\"]\n";
+    // (`sh -c` ignores the `--config FILE` appended to a plug-in's command.)
+    let extra = "command = [\"sh\", \"-c\", \"sleep 30\", \"never-connects\"]\n";
     std::fs::write(&file, text.replace(anchor, &format!("{anchor}{extra}"))).unwrap();
     let out = tmp.join("results");
     let running = Attsync::new(tmp.path())
