@@ -21,7 +21,7 @@ use msgs::config::{NodeConfig, Role};
 /// Runs any [`Stepper`] (your own agent model) behind the node loop: the
 /// way to write a plug-in agent in Rust (see `examples/saturated_agent/`).
 pub use runtime::run as run_stepper;
-pub use runtime::{NodeError, Stepper};
+pub use runtime::{Hooks, NoHooks, NodeError, Override, Stepper, run_with};
 use std::sync::atomic::AtomicBool;
 
 /// An agent behind the node loop. Inputs are its neighbours in id order,

@@ -31,6 +31,12 @@ impl Slot {
         stage_time_fraction(self.stage as usize)
     }
 
+    /// Whether this is the first stage of its step.
+    #[must_use]
+    pub fn starts_step(&self) -> bool {
+        self.stage == 0
+    }
+
     /// Whether this is the last stage of its step (the step is done after it).
     #[must_use]
     pub fn ends_step(&self) -> bool {
@@ -100,6 +106,7 @@ mod tests {
         assert_eq!(all.len(), 12);
         assert_eq!(all[5], (1, 1));
         assert!(s.slots().filter(Slot::ends_step).all(|x| x.stage == 3));
+        assert_eq!(s.slots().filter(Slot::starts_step).count(), 3);
     }
 
     #[test]

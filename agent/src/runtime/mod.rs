@@ -4,31 +4,43 @@
 //! 1. open every port; wait (bounded) until every receiver of our state, the
 //!    orchestrator's telemetry subscriber and the sender of every input are
 //!    connected; report `Ready`; wait (bounded) for `Start`;
-//! 2. step, either in deterministic lockstep (`lockstep.rs`, the default) or free
-//!    against the wall clock (`realtime.rs`);
+//! 2. step, walking the run's [`Schedule`] (stages, exchanges, stage
+//!    times), either in deterministic lockstep (`lockstep.rs`, the default)
+//!    or free against the wall clock (`realtime.rs`);
 //! 3. report the counters of the incoming links, then `Done`, and wait
 //!    (bounded) for `Stop`.
 //!
 //! Every received state is checked ([`StateMsg::validated`]); an invalid
 //! one is refused, counted and reported, and the node keeps the value it had.
+//! In every phase the node checks its parent at least every 100 ms and
+//! exits ([`NodeError::Orphaned`]) once the orchestrator is gone.
+//!
+//! # Layout
+//! - `ports.rs`: every iceoryx2 port and the readiness barrier.
+//! - `hooks.rs`: [`Hooks`], asked at every publish, receive, report and
+//!   command ([`run_with`]; [`run`] uses [`NoHooks`]).
+//! - `lockstep.rs`, `realtime.rs`: the two stepping loops.
+//! - here: [`Stepper`], [`NodeError`], the phases around the loops.
 
+mod hooks;
 mod lockstep;
 mod ports;
 mod realtime;
 
+pub use attitude::schedule::{Schedule, Slot};
+pub use hooks::{Hooks, NoHooks, Override};
+
 use attitude::link::LinkStats;
 use attitude::network::Exchanged;
+use hooks::Hooked;
 use iceoryx2::node::Node;
-use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::open::OpenError;
 use msgs::telemetry::peak_rss_kb;
-use msgs::{
-    ControlCommand, ControlMsg, Done, FailReason, PROTOCOL_VERSION, StateMsg, Telemetry,
-    unix_ns_now,
-};
+use msgs::{ControlCommand, Done, FailReason, PROTOCOL_VERSION, StateMsg, Telemetry, unix_ns_now};
 use ports::Ports;
+use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 use thiserror::Error;
@@ -103,6 +115,9 @@ pub enum NodeError {
     /// A peer broke the protocol.
     #[error("protocol violation: {0}")]
     Protocol(String),
+    /// A hook failed the node ([`Override::Fail`]).
+    #[error("failed by a hook: {0}")]
+    Injected(String),
     /// The process that started this node has exited.
     #[error("the orchestrator (pid {0}) has exited")]
     Orphaned(u32),
@@ -122,13 +137,25 @@ pub fn run<S: Service, N: Stepper>(
     stepper: &mut N,
     shutdown: &AtomicBool,
 ) -> Result<(), NodeError> {
+    run_with(node, cfg, stepper, &mut NoHooks, shutdown)
+}
+
+/// As [`run`], asking `hooks` at every publish, receive, report and command.
+pub fn run_with<S: Service, N: Stepper, H: Hooks>(
+    node: &Node<S>,
+    cfg: &NodeConfig,
+    stepper: &mut N,
+    hooks: &mut H,
+    shutdown: &AtomicBool,
+) -> Result<(), NodeError> {
     let orphan = Orphan::new();
     let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
     let ports = Ports::open(node, cfg)?;
-    ports.await_connections(cfg)?;
-    ports.report(cfg.id, &Telemetry::Ready)?;
+    ports.await_connections(cfg, &orphan)?;
+    let mut io = Hooked::new(&ports, hooks, cfg.id);
+    io.report(Telemetry::Ready)?;
     info!(id = cfg.id, inputs = ?cfg.inputs, outputs = ?cfg.outputs, "ready");
-    let start = match wait_command(&ports.control, start_timeout, shutdown, &orphan)? {
+    let start = match wait_command(&mut io, start_timeout, shutdown, &orphan)? {
         Some((ControlCommand::Start, start)) => start,
         _ => return Err(NodeError::Stopped(0)),
     };
@@ -137,9 +164,9 @@ pub fn run<S: Service, N: Stepper>(
 
     let mut inputs = Inputs::new(cfg);
     let stepped = match cfg.realtime {
-        None => lockstep::run(&ports, cfg, stepper, &mut inputs, shutdown, &orphan),
+        None => lockstep::run(&mut io, cfg, stepper, &mut inputs, shutdown, &orphan),
         Some(factor) => realtime::run(
-            &ports,
+            &mut io,
             cfg,
             stepper,
             &mut inputs,
@@ -154,13 +181,13 @@ pub fn run<S: Service, N: Stepper>(
             // Tell the orchestrator whom we waited for (or that it was
             // something else), so that it can name the node that hangs
             // (best effort: we are failing anyway).
-            let _ = ports.report(cfg.id, &Telemetry::Failed(failure(&e)));
+            let _ = io.report(Telemetry::Failed(failure(&e)));
             return Err(e);
         }
     };
     let done_unix_ns = unix_ns_now();
     for (from, stats) in inputs.stats(cfg, stepper.link_stats()) {
-        ports.report(cfg.id, &Telemetry::LinkStats { from, stats })?;
+        io.report(Telemetry::LinkStats { from, stats })?;
     }
     let done = Done {
         steps: cfg.steps,
@@ -170,11 +197,11 @@ pub fn run<S: Service, N: Stepper>(
         done_unix_ns,
         pacing,
     };
-    ports.report(cfg.id, &Telemetry::Done(done))?;
+    io.report(Telemetry::Done(done))?;
     info!(steps = cfg.steps, peak_rss_kb = done.peak_rss_kb, "done");
     // Other nodes may still be stepping: wait for Stop as long as the
     // orchestrator lives (bounded by STOP_TIMEOUT all the same).
-    match wait_command(&ports.control, STOP_TIMEOUT, shutdown, &orphan)? {
+    match wait_command(&mut io, STOP_TIMEOUT, shutdown, &orphan)? {
         Some((ControlCommand::Stop, _)) | None => Ok(()),
         Some((ControlCommand::Start, _)) => Err(NodeError::Protocol("second Start".into())),
     }
@@ -265,48 +292,62 @@ fn failure(e: &NodeError) -> FailReason {
 /// Longest wait for `Stop` after the last step.
 const STOP_TIMEOUT: Duration = Duration::from_secs(600);
 
+/// Longest time between two checks of the parent while a node runs, so
+/// that it exits well within a second of the orchestrator's death.
+const ORPHAN_CHECK: Duration = Duration::from_millis(100);
+
 /// Detects that the process that started us (the orchestrator) is gone, so
 /// that a node never outlives its run.
 #[derive(Debug)]
 pub(crate) struct Orphan {
     parent: u32,
+    last_check: Cell<Instant>,
 }
 
 impl Orphan {
     fn new() -> Self {
         Self {
             parent: std::os::unix::process::parent_id(),
+            last_check: Cell::new(Instant::now()),
         }
     }
 
+    /// Fails if the parent is gone (checks now).
     pub(crate) fn check(&self) -> Result<(), NodeError> {
+        self.last_check.set(Instant::now());
         if std::os::unix::process::parent_id() != self.parent {
             return Err(NodeError::Orphaned(self.parent));
         }
         Ok(())
     }
+
+    /// As [`Orphan::check`], if the last check is [`ORPHAN_CHECK`] old
+    /// (cheap enough for every step or poll).
+    pub(crate) fn poll(&self) -> Result<(), NodeError> {
+        if self.last_check.get().elapsed() >= ORPHAN_CHECK {
+            self.check()?;
+        }
+        Ok(())
+    }
 }
 
-/// Before step `n`: stop if told to, and (every 256 steps) if orphaned.
+/// Before step `n`: stop if told to, or if orphaned.
 pub(crate) fn before_step(n: u64, shutdown: &AtomicBool, orphan: &Orphan) -> Result<(), NodeError> {
     if shutdown.load(Ordering::Relaxed) {
         return Err(NodeError::Stopped(n));
     }
-    if n % 256 == 0 {
-        orphan.check()?;
-    }
-    Ok(())
+    orphan.poll()
 }
 
 /// After a step: report a sample if `done` steps make one due.
-pub(crate) fn after_step<S: Service, N: Stepper>(
-    ports: &Ports<S>,
+pub(crate) fn after_step<S: Service, N: Stepper, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
     cfg: &NodeConfig,
     stepper: &N,
     done: u64,
 ) -> Result<(), NodeError> {
     if done % cfg.sample_every == 0 || done == cfg.steps {
-        ports.report(cfg.id, &stepper.sample(done))?;
+        io.report(stepper.sample(done))?;
     }
     Ok(())
 }
@@ -331,17 +372,22 @@ pub(crate) fn check_origin(m: &StateMsg, sender: u32) -> Result<(), NodeError> {
     Ok(())
 }
 
-/// Waits (polling every millisecond, bounded) for a control command; returns
-/// it with its `start_unix_ns`.
-fn wait_command<S: Service>(
-    control: &Subscriber<S, ControlMsg, ()>,
+/// Waits (polling every millisecond, bounded) for a control command the
+/// hooks let through; returns it with its `start_unix_ns`.
+fn wait_command<S: Service, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
     timeout: Duration,
     shutdown: &AtomicBool,
     orphan: &Orphan,
 ) -> Result<Option<(ControlCommand, u64)>, NodeError> {
     let deadline = Instant::now() + timeout;
     loop {
-        if let Some(sample) = control.receive().map_err(port("control receive"))? {
+        if let Some(sample) = io
+            .ports
+            .control
+            .receive()
+            .map_err(port("control receive"))?
+        {
             if sample.version != PROTOCOL_VERSION {
                 return Err(NodeError::Protocol(format!(
                     "orchestrator speaks protocol version {}, this node {PROTOCOL_VERSION}",
@@ -349,7 +395,10 @@ fn wait_command<S: Service>(
                 )));
             }
             debug!(command = sample.command, "control");
-            return Ok(sample.command().map(|c| (c, sample.start_unix_ns)));
+            match sample.command() {
+                Some(c) if !io.obey(c)? => warn!(?c, "a hook ignores the command"),
+                c => return Ok(c.map(|c| (c, sample.start_unix_ns))),
+            }
         }
         if shutdown.load(Ordering::Relaxed) {
             return Ok(None);

@@ -1,6 +1,6 @@
 //! Every iceoryx2 port a node uses, and the readiness barrier.
 
-use super::{NodeError, port};
+use super::{NodeError, Orphan, port};
 use iceoryx2::node::Node;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
@@ -107,9 +107,9 @@ impl<S: Service> Ports<S> {
         })
     }
 
-    /// Readiness barrier: waits (bounded by the start timeout) until every
-    /// edge is connected in both directions.
-    pub fn await_connections(&self, cfg: &NodeConfig) -> Result<(), NodeError> {
+    /// Readiness barrier: waits (bounded by the start timeout, and by the
+    /// orchestrator's life) until every edge is connected in both directions.
+    pub fn await_connections(&self, cfg: &NodeConfig, orphan: &Orphan) -> Result<(), NodeError> {
         let ready_by = Instant::now() + Duration::from_secs_f64(cfg.start_timeout);
         loop {
             let subs_ok = self.own.dynamic_config().number_of_subscribers() >= cfg.outputs.len()
@@ -132,6 +132,7 @@ impl<S: Service> Ports<S> {
             if subs_ok && missing.is_empty() {
                 return Ok(());
             }
+            orphan.poll()?;
             if Instant::now() > ready_by {
                 return Err(NodeError::Timeout {
                     what: format!(

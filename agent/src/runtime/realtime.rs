@@ -2,7 +2,7 @@
 //! waits for its inputs.
 //!
 //! Stage s of step n begins at wall time `T₀ + (n + c_s)·dt / factor`
-//! (`c = [0, ½, ½, 1]`, `T₀` the `start_unix_ns` of the `Start` command, the
+//! (`c_s` = [`Slot::time_fraction`], `T₀` the `start_unix_ns` of the `Start` command, the
 //! same for every node). At an exchange the node publishes its stage state
 //! stamped with (n, s) and the wall clock, takes everything that has arrived
 //! on each input, keeps the freshest valid value, and advances with the
@@ -16,17 +16,15 @@
 //! exchange, `(now − sent_unix_ns of the held value) · factor` in simulated
 //! seconds: the real transport and scheduling latency.
 
-use super::ports::Ports;
-use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_origin, port};
+use super::hooks::{Hooked, Hooks};
+use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_origin};
 use attitude::link::LinkStats;
+use attitude::schedule::{Schedule, Slot};
 use iceoryx2::prelude::*;
 use msgs::config::NodeConfig;
 use msgs::{Pacing, StateMsg, unix_ns_now};
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
-
-/// Stage offsets of RKMK4 within a step.
-const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
 
 /// The wall-clock schedule of the run.
 #[derive(Debug, Clone, Copy)]
@@ -56,15 +54,32 @@ impl Clock {
         }
     }
 
-    /// When stage s of step n is due.
-    fn due(&self, n: u64, s: u32) -> Instant {
-        self.t0 + Duration::from_secs_f64((n as f64 + C[s as usize]) * self.step_wall)
+    /// When `slot` is due.
+    fn due(&self, slot: Slot) -> Instant {
+        self.t0
+            + Duration::from_secs_f64((slot.step as f64 + slot.time_fraction()) * self.step_wall)
     }
 }
 
+/// Per input: what the node has had from it so far.
+#[derive(Debug, Clone, Copy, Default)]
+struct Held {
+    /// Newest (step, stage) received.
+    newest: Option<(u64, u32)>,
+    /// Send time of the value held.
+    sent: Option<u64>,
+}
+
+/// How far behind the clock the node ran.
+#[derive(Debug, Default)]
+struct Lateness {
+    late_stages: u64,
+    max_late: f64,
+}
+
 /// Steps `cfg.steps` steps paced by `clock`; returns how well it kept to it.
-pub(crate) fn run<S: Service, N: Stepper>(
-    ports: &Ports<S>,
+pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
     cfg: &NodeConfig,
     stepper: &mut N,
     inputs: &mut Inputs,
@@ -72,81 +87,23 @@ pub(crate) fn run<S: Service, N: Stepper>(
     shutdown: &AtomicBool,
     orphan: &Orphan,
 ) -> Result<Pacing, NodeError> {
-    let k_in = ports.inputs.len();
-    let mut newest: Vec<Option<(u64, u32)>> = vec![None; k_in];
-    let mut held_sent: Vec<Option<u64>> = vec![None; k_in];
-    let (mut late_stages, mut max_late) = (0u64, 0.0f64);
+    let mut held = vec![Held::default(); cfg.inputs.len()];
+    let mut late = Lateness::default();
     let mut exchanges = 0u64;
-    ports.report(cfg.id, &stepper.sample(0))?;
-    for n in 0..cfg.steps {
-        before_step(n, shutdown, orphan)?;
-        for s in 0..4u32 {
-            let due = clock.due(n, s);
-            let now = Instant::now();
-            if now < due {
-                std::thread::sleep(due - now);
-            } else {
-                let late = (now - due).as_secs_f64();
-                max_late = max_late.max(late);
-                if late > clock.step_wall {
-                    late_stages += 1;
-                }
-            }
-            if !cfg.coupling.exchanges_at(n, s as usize) {
-                stepper.advance();
-                continue;
-            }
-            exchanges += 1;
-            let first = n == 0 && s == 0;
-            let msg = StateMsg::new(cfg.id, n, s, &stepper.stage_exchange()).stamped_now();
-            ports.publish(msg, first)?;
-            for k in 0..k_in {
-                let deadline = Instant::now() + Duration::from_secs_f64(cfg.stage_timeout);
-                let mut fresh = None;
-                loop {
-                    while let Some(sample) =
-                        ports.inputs[k].receive().map_err(port("state receive"))?
-                    {
-                        let m = *sample;
-                        check_origin(&m, cfg.inputs[k])?;
-                        if newest[k].is_some_and(|st| st >= (m.step, m.stage)) {
-                            continue;
-                        }
-                        newest[k] = Some((m.step, m.stage));
-                        if let Some(x) = inputs.accept(cfg, k, &m) {
-                            inputs.measured[k].delivered += 1;
-                            fresh = Some((x, m.sent_unix_ns));
-                        }
-                    }
-                    // Only the state at t = 0 is awaited.
-                    if !first || newest[k].is_some() {
-                        break;
-                    }
-                    if Instant::now() > deadline {
-                        return Err(NodeError::InputTimeout {
-                            from: cfg.inputs[k],
-                            step: 0,
-                            stage: 0,
-                            waited: cfg.stage_timeout,
-                        });
-                    }
-                    let _ = ports.listener.timed_wait(|_| {}, Duration::from_millis(1));
-                }
-                if let Some((x, sent)) = fresh {
-                    stepper.receive(k, x);
-                    held_sent[k] = Some(sent);
-                }
-                if let Some(sent) = held_sent[k] {
-                    let age = unix_ns_now().saturating_sub(sent) as f64 * 1e-9 * clock.factor;
-                    let st = &mut inputs.measured[k];
-                    st.age_sum += age;
-                    st.age_max = st.age_max.max(age);
-                    st.evaluations += 1;
-                }
-            }
-            stepper.advance();
+    io.report(stepper.sample(0))?;
+    for slot in Schedule::new(cfg.coupling, cfg.steps).slots() {
+        if slot.starts_step() {
+            before_step(slot.step, shutdown, orphan)?;
         }
-        after_step(ports, cfg, stepper, n + 1)?;
+        wait_until(clock, slot, &mut late, orphan)?;
+        if slot.exchange {
+            exchanges += 1;
+            exchange(io, cfg, stepper, inputs, &mut held, slot, clock.factor)?;
+        }
+        stepper.advance();
+        if slot.ends_step() {
+            after_step(io, cfg, stepper, slot.step + 1)?;
+        }
     }
     for st in &mut inputs.measured {
         // Every node makes the same exchanges: what a sender sent is what we made.
@@ -156,9 +113,102 @@ pub(crate) fn run<S: Service, N: Stepper>(
             ..*st
         };
     }
-    tracing::info!(late_stages, max_late_s = max_late, "real-time pacing");
+    tracing::info!(
+        late_stages = late.late_stages,
+        max_late_s = late.max_late,
+        "real-time pacing"
+    );
     Ok(Pacing {
-        late_stages,
-        max_lateness: max_late,
+        late_stages: late.late_stages,
+        max_lateness: late.max_late,
     })
+}
+
+/// Sleeps until `slot` is due (checking the parent meanwhile), or records
+/// how late it is.
+fn wait_until(
+    clock: Clock,
+    slot: Slot,
+    late: &mut Lateness,
+    orphan: &Orphan,
+) -> Result<(), NodeError> {
+    let due = clock.due(slot);
+    let now = Instant::now();
+    if now >= due {
+        let by = (now - due).as_secs_f64();
+        late.max_late = late.max_late.max(by);
+        if by > clock.step_wall {
+            late.late_stages += 1;
+        }
+        return Ok(());
+    }
+    loop {
+        let now = Instant::now();
+        if now >= due {
+            return Ok(());
+        }
+        std::thread::sleep((due - now).min(Duration::from_millis(100)));
+        orphan.poll()?;
+    }
+}
+
+/// Exchange `slot`: publish, take everything that has arrived on each
+/// input, keep the freshest valid value, and measure its age.
+fn exchange<S: Service, N: Stepper, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
+    cfg: &NodeConfig,
+    stepper: &mut N,
+    inputs: &mut Inputs,
+    held: &mut [Held],
+    slot: Slot,
+    factor: f64,
+) -> Result<(), NodeError> {
+    let first = slot.step == 0 && slot.stage == 0;
+    let msg = StateMsg::new(cfg.id, slot.step, slot.stage, &stepper.stage_exchange()).stamped_now();
+    io.publish(slot, msg, first)?;
+    for k in 0..cfg.inputs.len() {
+        let deadline = Instant::now() + Duration::from_secs_f64(cfg.stage_timeout);
+        let mut fresh = None;
+        loop {
+            while let Some(m) = io.receive(k)? {
+                check_origin(&m, cfg.inputs[k])?;
+                if held[k].newest.is_some_and(|st| st >= (m.step, m.stage)) {
+                    continue;
+                }
+                held[k].newest = Some((m.step, m.stage));
+                if let Some(x) = inputs.accept(cfg, k, &m) {
+                    inputs.measured[k].delivered += 1;
+                    fresh = Some((x, m.sent_unix_ns));
+                }
+            }
+            // Only the state at t = 0 is awaited.
+            if !first || held[k].newest.is_some() {
+                break;
+            }
+            if Instant::now() > deadline {
+                return Err(NodeError::InputTimeout {
+                    from: cfg.inputs[k],
+                    step: 0,
+                    stage: 0,
+                    waited: cfg.stage_timeout,
+                });
+            }
+            let _ = io
+                .ports
+                .listener
+                .timed_wait(|_| {}, Duration::from_millis(1));
+        }
+        if let Some((x, sent)) = fresh {
+            stepper.receive(k, x);
+            held[k].sent = Some(sent);
+        }
+        if let Some(sent) = held[k].sent {
+            let age = unix_ns_now().saturating_sub(sent) as f64 * 1e-9 * factor;
+            let st = &mut inputs.measured[k];
+            st.age_sum += age;
+            st.age_max = st.age_max.max(age);
+            st.evaluations += 1;
+        }
+    }
+    Ok(())
 }
