@@ -44,35 +44,12 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
     if p.leader_links == 0 || p.leader_links > p.agents {
         return Err(format!("--leader-links must be in 1..={}", p.agents));
     }
+    // The draws, in this order, are the seed's contract: agents, edges, links.
     let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
-    let diag = |c: f64, m: f64| MatrixSpec::Diagonal([c + m, c + 1.0 + m, c + 2.0 + m]);
     let has_obs = p.scheme != SchemeKind::Observerless;
-    let mut agents = Vec::new();
-    for id in 1..=p.agents {
-        let inertia = MatrixSpec::Diagonal([
-            rng.random_range(0.1..1.0),
-            rng.random_range(0.1..1.0),
-            rng.random_range(0.1..1.0),
-        ]);
-        let attitude = random_rotation(&mut rng);
-        let omega = random_vec(&mut rng, 1.0);
-        let control_gain = has_obs.then(|| diag(10.0, rng.random_range(0.0..5.0)));
-        let observer = has_obs.then(|| ObserverInit {
-            attitude: random_rotation(&mut rng),
-            omega: random_vec(&mut rng, 1.0),
-            sigma: (p.scheme == SchemeKind::ObserverTimeVarying).then(|| random_vec(&mut rng, 0.5)),
-        });
-        agents.push(AgentSpec {
-            id,
-            inertia,
-            attitude,
-            omega,
-            control_gain,
-            observer,
-            command: None,
-            env: None,
-        });
-    }
+    let agents = (1..=p.agents)
+        .map(|id| random_agent(&mut rng, id, p.scheme))
+        .collect();
     let (c_edge, c_link) = if has_obs { (10.0, 14.0) } else { (3.0, 5.0) };
     let edges = (2..=p.agents)
         .map(|k| EdgeSpec {
@@ -80,71 +57,8 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
             gain: diag(c_edge, rng.random_range(0.0..5.0)),
         })
         .collect();
-    let mut linked: Vec<u32> = sample(&mut rng, p.agents as usize, p.leader_links as usize)
-        .into_iter()
-        .map(|i| i as u32 + 1)
-        .collect();
-    linked.sort_unstable();
-    let leader_links = linked
-        .into_iter()
-        .map(|agent| LeaderLinkSpec {
-            agent,
-            gain: diag(c_link, rng.random_range(0.0..5.0)),
-        })
-        .collect();
-    let (scheme, leader) = match p.scheme {
-        SchemeKind::ObserverTimeVarying => (
-            SchemeSpec {
-                kind: p.scheme,
-                observer: Some(ObserverGainsSpec {
-                    k_r: 9.0,
-                    k_omega: 14.0,
-                    k_sigma: Some(12.0),
-                }),
-                control: ControlGainsSpec {
-                    k_r: 8.0,
-                    k_omega: 13.0,
-                },
-            },
-            LeaderSpec {
-                reference: ReferenceKind::TimeVarying,
-                p: Some(PAPER_P),
-                attitude: RotationSpec {
-                    axis: Some([1.0, 4.0, 2.0]),
-                    angle_pi: Some(0.8),
-                    ..Default::default()
-                },
-                omega: Some([1.0, 2.0, 0.0]),
-                sigma: Some([0.2, 1.0, 0.0]),
-            },
-        ),
-        SchemeKind::ObserverConstant => (
-            SchemeSpec {
-                kind: p.scheme,
-                observer: Some(ObserverGainsSpec {
-                    k_r: 14.0,
-                    k_omega: 12.0,
-                    k_sigma: None,
-                }),
-                control: ControlGainsSpec {
-                    k_r: 13.0,
-                    k_omega: 11.0,
-                },
-            },
-            constant_leader(),
-        ),
-        SchemeKind::Observerless => (
-            SchemeSpec {
-                kind: p.scheme,
-                observer: None,
-                control: ControlGainsSpec {
-                    k_r: 1.9,
-                    k_omega: 1.9,
-                },
-            },
-            constant_leader(),
-        ),
-    };
+    let leader_links = random_leader_links(&mut rng, p, c_link);
+    let (scheme, leader) = paper_scheme_and_leader(p.scheme);
     let mut scenario = Scenario {
         name: Some(format!(
             "tree-{}-{}-seed{}",
@@ -170,6 +84,102 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
     };
     raise_k_sigma_until_theorem_1_holds(&mut scenario);
     Ok(scenario)
+}
+
+/// A gain matrix like the paper's: `diag(c+m, c+1+m, c+2+m)` (SPD, distinct eigenvalues).
+fn diag(c: f64, m: f64) -> MatrixSpec {
+    MatrixSpec::Diagonal([c + m, c + 1.0 + m, c + 2.0 + m])
+}
+
+/// Agent `id` with a random inertia, initial state and (observer schemes)
+/// control gain and observer initial state.
+fn random_agent(rng: &mut ChaCha8Rng, id: u32, scheme: SchemeKind) -> AgentSpec {
+    let has_obs = scheme != SchemeKind::Observerless;
+    let inertia = MatrixSpec::Diagonal([
+        rng.random_range(0.1..1.0),
+        rng.random_range(0.1..1.0),
+        rng.random_range(0.1..1.0),
+    ]);
+    let attitude = random_rotation(rng);
+    let omega = random_vec(rng, 1.0);
+    let control_gain = has_obs.then(|| diag(10.0, rng.random_range(0.0..5.0)));
+    let observer = has_obs.then(|| ObserverInit {
+        attitude: random_rotation(rng),
+        omega: random_vec(rng, 1.0),
+        sigma: (scheme == SchemeKind::ObserverTimeVarying).then(|| random_vec(rng, 0.5)),
+    });
+    AgentSpec {
+        id,
+        inertia,
+        attitude,
+        omega,
+        control_gain,
+        observer,
+        command: None,
+        env: None,
+    }
+}
+
+/// `p.leader_links` distinct agents that hear the leader, with gains `diag(c, …)`.
+fn random_leader_links(rng: &mut ChaCha8Rng, p: &TreeParams, c: f64) -> Vec<LeaderLinkSpec> {
+    let mut linked: Vec<u32> = sample(rng, p.agents as usize, p.leader_links as usize)
+        .into_iter()
+        .map(|i| i as u32 + 1)
+        .collect();
+    linked.sort_unstable();
+    linked
+        .into_iter()
+        .map(|agent| LeaderLinkSpec {
+            agent,
+            gain: diag(c, rng.random_range(0.0..5.0)),
+        })
+        .collect()
+}
+
+/// The paper's gains and reference for `kind`.
+fn paper_scheme_and_leader(kind: SchemeKind) -> (SchemeSpec, LeaderSpec) {
+    let scheme = |observer, k_r, k_omega| SchemeSpec {
+        kind,
+        observer,
+        control: ControlGainsSpec { k_r, k_omega },
+    };
+    match kind {
+        SchemeKind::ObserverTimeVarying => (
+            scheme(
+                Some(ObserverGainsSpec {
+                    k_r: 9.0,
+                    k_omega: 14.0,
+                    k_sigma: Some(12.0),
+                }),
+                8.0,
+                13.0,
+            ),
+            LeaderSpec {
+                reference: ReferenceKind::TimeVarying,
+                p: Some(PAPER_P),
+                attitude: RotationSpec {
+                    axis: Some([1.0, 4.0, 2.0]),
+                    angle_pi: Some(0.8),
+                    ..Default::default()
+                },
+                omega: Some([1.0, 2.0, 0.0]),
+                sigma: Some([0.2, 1.0, 0.0]),
+            },
+        ),
+        SchemeKind::ObserverConstant => (
+            scheme(
+                Some(ObserverGainsSpec {
+                    k_r: 14.0,
+                    k_omega: 12.0,
+                    k_sigma: None,
+                }),
+                13.0,
+                11.0,
+            ),
+            constant_leader(),
+        ),
+        SchemeKind::Observerless => (scheme(None, 1.9, 1.9), constant_leader()),
+    }
 }
 
 /// For scheme 1, doubles `k_σ` until the matrix F of Appendix D is positive

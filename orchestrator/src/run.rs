@@ -5,7 +5,9 @@ use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
 use crate::outcome::Outcome;
 use crate::processes::{self, ProcessError, ProcessOptions};
-use crate::results::{self, Recorder, Summary, plot, staging::Staging};
+use crate::results::layout::RunLayout;
+use crate::results::summary::{LinkSummary, NodeSummary};
+use crate::results::{self, Recorder, Series, Summary, plot, staging::Staging};
 use crate::scenario::Loaded;
 use attitude::engine::InProcess;
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
@@ -106,19 +108,33 @@ fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 /// early, keeping the results so far marked incomplete (the reason names
 /// the signal, [`crate::interrupt::reason`]), when `interrupt` is raised.
 pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<Summary, RunError> {
-    let net = &loaded.resolved.network;
     opts.validate()?;
     check_options(loaded, opts)?;
-    let mut process_opts = opts.processes.clone();
-    process_opts.plugins = loaded.resolved.plugins.clone();
     let staging = Staging::new(&opts.out).map_err(io_at(&opts.out))?;
-    let dir = staging.path().to_owned();
+    let layout = RunLayout::new(staging.path());
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
-    std::fs::write(dir.join("scenario.toml"), text).map_err(io_at(&dir))?;
-    let mut recorder = Recorder::new(&dir, &loaded.name(), net).map_err(io_at(&dir))?;
-
-    let bar = progress_bar(opts.progress, net.steps, net.dt);
+    std::fs::write(layout.scenario(), text).map_err(io_at(layout.root()))?;
     let started = Instant::now();
+    let (outcome, series) = drive(loaded, opts, &layout, interrupt)?;
+    let wall_seconds = started.elapsed().as_secs_f64();
+    let summary = summarise(loaded, opts, outcome, &series, wall_seconds);
+    write_results(&layout, &summary, &series)?;
+    staging.commit().map_err(io_at(&opts.out))?;
+    Ok(summary)
+}
+
+/// Runs the engine, recording every snapshot into `layout`; how it ended
+/// (its failure naming the signal if interrupted) and the recorded series.
+fn drive(
+    loaded: &Loaded,
+    opts: &RunOptions,
+    layout: &RunLayout,
+    interrupt: &Interrupt,
+) -> Result<(Outcome, Vec<Series>), RunError> {
+    let net = &loaded.resolved.network;
+    let dir = layout.root();
+    let mut recorder = Recorder::new(dir, &loaded.name(), net).map_err(io_at(dir))?;
+    let bar = progress_bar(opts.progress, net.steps, net.dt);
     let mut write_error = None;
     let mut record = |snap: &attitude::engine::Snapshot<'_>| {
         if let Err(e) = recorder.record(snap) {
@@ -133,58 +149,61 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
             engine.run(|snap| {
-                if interrupt.is_set() {
-                    interrupted = true;
-                    return false;
-                }
-                record(snap)
+                interrupted = interrupt.is_set();
+                !interrupted && record(snap)
             });
             Outcome::in_process(&engine, interrupted)
         }
         Engine::Processes => {
-            let logs = dir.join("logs");
-            processes::run(net, &process_opts, &logs, interrupt.flag(), record)?
+            let mut process_opts = opts.processes.clone();
+            process_opts.plugins = loaded.resolved.plugins.clone();
+            processes::run(net, &process_opts, &layout.logs(), interrupt.flag(), record)?
         }
     };
-    // An engine stopped by the interrupt says "interrupted": say which signal.
-    let failure = outcome.failure.map(|f| match f.strip_suffix("interrupted") {
-        Some(blame) if interrupt.is_set() => blame.to_owned() + &interrupted_reason(interrupt),
-        _ => f,
-    });
-    let Outcome {
-        peak_torques: peaks,
-        steps,
-        links,
-        pacing,
-        nodes,
-        ..
-    } = outcome;
-    let wall_seconds = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
     if let Some(e) = write_error {
-        return Err(io_at(&dir)(e));
+        return Err(io_at(dir)(e));
     }
-    let series = recorder.finish().map_err(io_at(&dir))?;
-    let mut agents = results::agent_summaries(&series, &peaks);
-    for (a, p) in agents.iter_mut().zip(&pacing) {
+    let series = recorder.finish().map_err(io_at(dir))?;
+    // An engine stopped by the interrupt says "interrupted": say which signal.
+    let failure = outcome
+        .failure
+        .map(|f| match f.strip_suffix("interrupted") {
+            Some(blame) if interrupt.is_set() => blame.to_owned() + &interrupted_reason(interrupt),
+            _ => f,
+        });
+    Ok((Outcome { failure, ..outcome }, series))
+}
+
+/// `summary.json` of a run that ended as `outcome` with `series` recorded.
+fn summarise(
+    loaded: &Loaded,
+    opts: &RunOptions,
+    outcome: Outcome,
+    series: &[Series],
+    wall_seconds: f64,
+) -> Summary {
+    let net = &loaded.resolved.network;
+    let mut agents = results::agent_summaries(series, &outcome.peak_torques);
+    for (a, p) in agents.iter_mut().zip(&outcome.pacing) {
         if opts.processes.realtime.is_some() {
             (a.late_stages, a.max_lateness) = (Some(p.0), Some(p.1));
         }
     }
     for a in &mut agents {
-        a.plugin = loaded
-            .resolved
-            .plugins
+        let plugins = &loaded.resolved.plugins;
+        a.plugin = plugins
             .iter()
             .find(|p| p.agent == a.id)
             .map(|p| p.display());
     }
-    let summary = Summary {
+    let steps = outcome.steps;
+    Summary {
         attsync_version: env!("CARGO_PKG_VERSION").into(),
         scenario: loaded.name(),
         engine: opts.engine.name().into(),
-        complete: failure.is_none() && steps == net.steps,
-        incomplete_reason: failure,
+        complete: outcome.failure.is_none() && steps == net.steps,
+        incomplete_reason: outcome.failure,
         dt: net.dt,
         duration: net.steps as f64 * net.dt,
         t_end: steps as f64 * net.dt,
@@ -192,49 +211,26 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
         wall_seconds,
         max_final_att_err: agents.iter().map(|a| a.final_att_err).fold(0.0, f64::max),
         agents,
-        links: links
-            .iter()
-            .map(|(from, to, st)| results::summary::LinkSummary {
-                from: *from,
-                to: *to,
-                sent: st.sent,
-                delivered: st.delivered,
-                lost: st.lost,
-                aoi_mean: if st.evaluations > 0 {
-                    st.age_sum / st.evaluations as f64
-                } else {
-                    0.0
-                },
-                aoi_max: st.age_max,
-                rejected: st.rejected,
-            })
+        links: (outcome.links.iter())
+            .map(|(from, to, st)| LinkSummary::of(*from, *to, st))
             .collect(),
         realtime: opts.processes.realtime,
-        nodes: nodes
-            .into_iter()
-            .map(|(name, id, d)| results::summary::NodeSummary {
-                id,
-                name,
-                peak_rss_kb: d.peak_rss_kb,
-                started_unix_ns: d.started_unix_ns,
-                done_unix_ns: d.done_unix_ns,
-            })
+        nodes: (outcome.nodes.iter())
+            .map(|(name, id, d)| NodeSummary::of(*id, name, d))
             .collect(),
-    };
-    let svg = dir.join("errors.svg");
-    plot::draw(
-        &svg,
-        &format!("{} ({})", summary.scenario, summary.engine),
-        &series,
-    )
-    .map_err(|message| RunError::Plot {
+    }
+}
+
+/// Writes the plot, then `summary.json` (last: it marks the directory as
+/// complete results).
+fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Result<(), RunError> {
+    let svg = layout.errors_svg();
+    let title = format!("{} ({})", summary.scenario, summary.engine);
+    plot::draw(&svg, &title, series).map_err(|message| RunError::Plot {
         path: svg.clone(),
         message,
     })?;
-    // summary.json last: it marks the directory as complete results.
-    results::write_summary(&dir, &summary).map_err(io_at(&dir))?;
-    staging.commit().map_err(io_at(&opts.out))?;
-    Ok(summary)
+    results::write_summary(layout.root(), summary).map_err(io_at(layout.root()))
 }
 
 /// `incomplete_reason` of an interrupted run.

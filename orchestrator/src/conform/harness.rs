@@ -4,8 +4,8 @@
 //! (rule `connects`), the exchanges ([`super::lockstep`]), then `Done` and
 //! `Stop` (rules `telemetry`, `stops`).
 
-use super::law::LawRecord;
 use super::candidate::{Candidate, EXIT_TIMEOUT, candidate_config, log_tail, success};
+use super::law::LawRecord;
 use super::rules::{Report, RuleId};
 use super::telemetry_check::TelemetryCheck;
 use super::wires::Wires;

@@ -112,6 +112,41 @@ pub struct NodeSummary {
     pub done_unix_ns: u64,
 }
 
+impl LinkSummary {
+    /// The summary of link `from` → `to` with counters `st`.
+    #[must_use]
+    pub fn of(from: u32, to: u32, st: &attitude::link::LinkStats) -> Self {
+        Self {
+            from,
+            to,
+            sent: st.sent,
+            delivered: st.delivered,
+            lost: st.lost,
+            aoi_mean: if st.evaluations > 0 {
+                st.age_sum / st.evaluations as f64
+            } else {
+                0.0
+            },
+            aoi_max: st.age_max,
+            rejected: st.rejected,
+        }
+    }
+}
+
+impl NodeSummary {
+    /// The summary of node `id` (`name`) from its `Done` report.
+    #[must_use]
+    pub fn of(id: u32, name: &str, d: &msgs::Done) -> Self {
+        Self {
+            id,
+            name: name.to_owned(),
+            peak_rss_kb: d.peak_rss_kb,
+            started_unix_ns: d.started_unix_ns,
+            done_unix_ns: d.done_unix_ns,
+        }
+    }
+}
+
 /// Time after which `err` stays below `threshold`: the sample after the last
 /// one at or above it; `Some(t[0])` if always below; `None` if the last
 /// sample is not below.
