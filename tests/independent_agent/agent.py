@@ -3,8 +3,8 @@
 
     python3 agent.py --config node-<id>.json      (or ATTSYNC_CONFIG=…)
 
-All three schemes, lockstep, continuous and sampled coupling. Not done
-(refused with a message and exit code 2): link impairments (§ 10.9),
+All three schemes, lockstep, continuous and sampled coupling, impaired
+links (§ 10.9). Not done (refused with a message and exit code 2):
 real-time mode (§ 7), the leader role. Needs PyPI `iceoryx2==0.10.0`.
 """
 
@@ -18,6 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import arith  # noqa: E402
 import wire  # noqa: E402
+from link import C_STAGE, Link  # noqa: E402
 from model import Agent, ConfigRefused  # noqa: E402
 
 EXIT_REFUSED = 2
@@ -61,17 +62,18 @@ def refuse_unsupported(cfg):
         raise ConfigRefused(f"role {role['kind']!r}: only agents are implemented")
     if cfg.get("realtime") is not None:
         raise ConfigRefused("real-time mode (PROTOCOL.md § 7) is not implemented")
-    model = role["model"]
-    impaired = [n["id"] for n in model["neighbours"] if n.get("link") is not None]
-    if model.get("leader_link") is not None:
-        impaired.append(0)
-    if impaired:
-        raise ConfigRefused(
-            f"link impairments (PROTOCOL.md § 10.9) are not implemented; impaired inputs: {impaired}"
-        )
     mode = cfg["coupling"]["mode"]
     if mode not in ("continuous", "sampled"):
         raise ConfigRefused(f"coupling mode {mode!r}")
+
+
+def input_links(cfg):
+    """A :class:`Link` per impaired input (inputs order), None if ideal."""
+    model = cfg["role"]["model"]
+    specs = [n.get("link") for n in model["neighbours"]]
+    if model.get("leader_gain") is not None:
+        specs.append(model.get("leader_link"))
+    return [Link(spec) if spec is not None else None for spec in specs]
 
 
 def is_exchange(coupling, n, s):
@@ -189,6 +191,9 @@ class Node:
         agent = Agent(cfg)
         coupling, steps, every = cfg["coupling"], int(cfg["steps"]), int(cfg["sample_every"])
         rejected = [0] * len(cfg["inputs"])
+        links = input_links(cfg)
+        ages = [[0.0, 0.0] for _ in links]  # age_sum, age_max per input
+        dt = float(cfg["dt"])
         exchanges = 0
         self.barrier()
         self.telemetry(wire.telemetry(self.id, wire.READY))
@@ -205,17 +210,32 @@ class Node:
                         notifier.notify()
                     for k in range(len(cfg["inputs"])):
                         value = self.receive(k, n, s)
-                        if arith.is_valid_state(*value):
-                            agent.held[k] = value
-                        else:
+                        if not arith.is_valid_state(*value):
                             rejected[k] += 1
+                        elif links[k] is not None:
+                            links[k].offer(n, s, value)
+                        else:
+                            agent.held[k] = value
+                for k, link in enumerate(links):
+                    if link is not None:
+                        value = link.value_at(n, s)
+                        if value is not None:
+                            agent.held[k] = value
+                            (m, c) = link.held[0]
+                            age = ((n + C_STAGE[s]) - (m + C_STAGE[c])) * dt
+                            ages[k][0] += age
+                            ages[k][1] = max(ages[k][1], age)
                 agent.evaluate(s)
             if (n + 1) % every == 0 or n + 1 == steps:
                 self.report_sample(agent, n + 1)
         done = time.time_ns()
         for k, frm in enumerate(cfg["inputs"]):
-            if rejected[k]:
-                self.telemetry(wire.link_stats(self.id, frm, exchanges, exchanges, rejected[k],
+            if links[k] is not None:
+                link = links[k]
+                self.telemetry(wire.link_stats(self.id, frm, link.sent, link.delivered, link.lost,
+                                               rejected[k], 4 * steps, *ages[k]))
+            elif rejected[k]:
+                self.telemetry(wire.link_stats(self.id, frm, exchanges, exchanges, 0, rejected[k],
                                                4 * steps, 0.0, 0.0))
         self.telemetry(wire.done(self.id, steps, agent.peak_torque, peak_rss_kb(), started, done))
         self.control(wire.STOP, STOP_WAIT_S)

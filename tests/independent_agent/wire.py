@@ -109,7 +109,7 @@ def done(sender, steps, peak_torque, peak_rss_kb, started_ns, done_ns):
     )
 
 
-def link_stats(sender, frm, sent, delivered, rejected, evaluations, age_sum, age_max):
+def link_stats(sender, frm, sent, delivered, lost, rejected, evaluations, age_sum, age_max):
     """Kind 4: from u32 @16, then u64s from @24."""
     return telemetry(
         sender,
@@ -118,7 +118,7 @@ def link_stats(sender, frm, sent, delivered, rejected, evaluations, age_sum, age
         frm,
         sent,
         delivered,
-        sent - delivered,
+        lost,
         rejected,
         evaluations,
         age_sum,
