@@ -68,7 +68,10 @@ fn assert_bit_identical(name: &str, scenario: &Path, positions: &[usize], sets: 
     let (s, b) = (summary(&ind), summary(&builtin));
     assert_eq!(s["complete"], true, "{s:#}");
     assert_eq!(s["steps"], b["steps"]);
-    let (sa, ba) = (s["agents"].as_array().unwrap(), b["agents"].as_array().unwrap());
+    let (sa, ba) = (
+        s["agents"].as_array().unwrap(),
+        b["agents"].as_array().unwrap(),
+    );
     for &k in positions {
         let plugin = sa[k]["plugin"].as_str().unwrap_or_default();
         assert!(plugin.contains("independent_agent/agent.py"), "{s:#}");
@@ -76,7 +79,12 @@ fn assert_bit_identical(name: &str, scenario: &Path, positions: &[usize], sets: 
     // The link counters and ages of information (LinkStats, § 5) too.
     assert_eq!(s["links"], b["links"], "summary.json links differ");
     for (x, y) in sa.iter().zip(ba) {
-        for key in ["final_att_err", "final_angvel_err", "final_obs_att_err", "peak_torque"] {
+        for key in [
+            "final_att_err",
+            "final_angvel_err",
+            "final_obs_att_err",
+            "peak_torque",
+        ] {
             assert_eq!(x[key], y[key], "agent {}: {key}", x["id"]);
         }
     }
