@@ -13,9 +13,9 @@ use attsync_tests::{Attsync, Sandbox, assert_same_bytes, paper, run_args, summar
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Simulated seconds per run: 3000 steps of the paper's dt = 1 ms, 12 000
+/// Simulated seconds per run: 5000 steps of the paper's dt = 1 ms, 20 000
 /// exchanges (the Python agent is slow; the built-in run is cut alike).
-const DURATION: &str = "simulation.duration=3";
+const DURATION: &str = "simulation.duration=5";
 
 fn agent_py() -> PathBuf {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("independent_agent/agent.py");
