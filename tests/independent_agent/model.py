@@ -1,0 +1,97 @@
+"""PROTOCOL.md § 10.5-10.8: an agent's state, held values and stages.
+
+No IPC here: :class:`Agent` is fed the received states and says what to
+publish, so the model can be read (and tested) without iceoryx2.
+"""
+
+import arith as m
+
+SCHEMES = ("observer-time-varying", "observer-constant", "observerless")
+
+
+class ConfigRefused(Exception):
+    """The configuration asks for something this agent does not do."""
+
+
+class Agent:
+    """An agent of one of the three schemes, stepped stage by stage."""
+
+    def __init__(self, cfg):
+        role = cfg["role"]
+        model, initial = role["model"], role["initial"]
+        self.scheme = model["scheme"]["kind"]
+        if self.scheme not in SCHEMES:
+            raise ConfigRefused(f"unknown scheme {self.scheme!r}")
+        self.observer = model["scheme"].get("observer")
+        self.control = model["scheme"]["control"]
+        self.j = m.from_config(model["inertia"]["j"])
+        self.j_inv = m.from_config(model["inertia"]["j_inv"])
+        self.a_bar = m.from_config(model["a_bar"]) if model.get("a_bar") else None
+        self.p = m.from_config(model["p"]) if model.get("p") else None
+        self.gains = [m.from_config(n["a"]) for n in model["neighbours"]]
+        lg = model.get("leader_gain")
+        self.leader_gain = m.from_config(lg) if lg is not None else None
+        self.inputs = list(cfg["inputs"])
+        hears = 1 if self.leader_gain is not None else 0
+        if len(self.gains) + hears != len(self.inputs):
+            raise ConfigRefused(
+                f"inputs {self.inputs} do not match {len(self.gains)} neighbours"
+                f" and leader_gain {lg}"
+            )
+        # § 10.5 / § 8: before anything valid arrives an input holds (I, 0, 0).
+        self.held = [(m.I3, m.Z3, m.Z3) for _ in self.inputs]
+        rots = [m.from_config(initial["r"]), m.from_config(initial["r_hat"])]
+        vecs = [m.vec(initial["w"]), m.vec(initial["w_hat"]), m.vec(initial["s_hat"])]
+        self.rk = m.Rkmk4(rots, vecs, float(cfg["dt"]))
+        self.peak_torque = 0.0
+        self.point = None
+
+    # --- what travels ------------------------------------------------------
+
+    def stage_point(self, s):
+        """Computes (and keeps) stage ``s``'s point; returns what to publish
+        at that exchange: (r, w, s) per § 10.5."""
+        rots, vecs = self.rk.point(s)
+        self.point = (rots, vecs)
+        r, rh = rots
+        w, wh, sh = vecs
+        if self.scheme == "observerless":
+            return r, w, m.Z3
+        return rh, wh, sh
+
+    def sample(self):
+        """(r, w, r_hat, w_hat, s_hat) at the start of the current step."""
+        (r, rh), (w, wh, sh) = self.rk.r0, self.rk.x0
+        return r, w, rh, wh, sh
+
+    # --- one stage (§ 10.8) --------------------------------------------------
+
+    def evaluate(self, s):
+        """Evaluates stage ``s`` at the point of :meth:`stage_point` with the
+        held values, and advances the integrator."""
+        (r, rh), (w, wh, sh) = self.point
+        k_nb = len(self.gains)
+        neighbours = list(zip(self.gains, self.held[:k_nb]))
+        leader = None
+        if self.leader_gain is not None:
+            leader = (self.leader_gain, self.held[k_nb])
+        if self.scheme == "observer-time-varying":
+            wh_dot, sh_dot = m.observer_time_varying(
+                self.observer, self.p, rh, wh, sh, leader, neighbours
+            )
+            tau = m.control_observer(
+                self.control, self.j, self.a_bar, r, w, rh, wh, wh_dot, True
+            )
+        elif self.scheme == "observer-constant":
+            wh_dot, sh_dot = m.observer_constant(self.observer, rh, wh, leader, neighbours)
+            tau = m.control_observer(
+                self.control, self.j, self.a_bar, r, w, rh, wh, wh_dot, False
+            )
+        else:
+            wh_dot, sh_dot = m.Z3, m.Z3
+            tau = m.control_observerless(self.control, r, w, leader, neighbours)
+        w_dot = m.mv(self.j_inv, m.sub(tau, m.cross(w, m.mv(self.j, w))))
+        omegas = [w, m.Z3 if self.scheme == "observerless" else wh]
+        if s == 0:
+            self.peak_torque = max(self.peak_torque, m.norm(tau))
+        self.rk.update(s, omegas, [w_dot, wh_dot, sh_dot])
