@@ -53,7 +53,7 @@ fn network() -> Network {
 fn node(cfg: &NodeConfig) -> Result<(), NodeError> {
     let name = format!("node_{}", cfg.id);
     let node = msgs::iox::create_node::<Local>(&cfg.run, Path::new(&cfg.iox_root), &name)
-        .map_err(|e| NodeError::Port(e.to_string()))?;
+        .map_err(NodeError::Port)?;
     let shutdown = AtomicBool::new(false);
     match cfg.role {
         Role::Leader { .. } => {

@@ -79,10 +79,13 @@ impl BenchError {
     }
 
     /// An [`BenchError::Iceoryx`] error of `what`, from iceoryx2's (Debug) error.
-    pub fn iox<E: std::fmt::Debug>(what: &str) -> impl FnOnce(E) -> Self + '_ {
-        move |e| Self::Iceoryx {
-            what: what.to_string(),
-            detail: format!("{e:?}"),
+    pub fn iox<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> Self {
+        move |e| {
+            let e = msgs::iox::iox(what)(e);
+            Self::Iceoryx {
+                what: e.what.to_string(),
+                detail: e.detail,
+            }
         }
     }
 

@@ -67,7 +67,7 @@ impl RunOptions {
 /// The default results directory: `results/<scenario name>`.
 #[must_use]
 pub fn default_out(loaded: &Loaded) -> PathBuf {
-    PathBuf::from("results").join(loaded.name())
+    crate::results::layout::default_run_dir(&loaded.name())
 }
 
 /// Why a run produced no results.
@@ -111,6 +111,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     opts.validate()?;
     check_options(loaded, opts)?;
     let staging = Staging::new(&opts.out).map_err(io_at(&opts.out))?;
+    tracing::debug!(staging = %staging.path().display(), engine = opts.engine.name(), "run: staged");
     let layout = RunLayout::new(staging.path());
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
     std::fs::write(layout.scenario(), text).map_err(io_at(layout.root()))?;
@@ -120,6 +121,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let summary = summarise(loaded, opts, outcome, &series, wall_seconds);
     write_results(&layout, &summary, &series)?;
     staging.commit().map_err(io_at(&opts.out))?;
+    tracing::debug!(out = %opts.out.display(), complete = summary.complete, "run: committed");
     Ok(summary)
 }
 

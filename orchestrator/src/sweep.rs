@@ -10,6 +10,7 @@
 //! invalid `--set`); bisection points are rounded to a quantum, by default
 //! the step `simulation.dt` for a timing field ([`default_quantum`]).
 
+use crate::results::layout::SweepLayout;
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
 use crate::results::staging::Staging;
@@ -151,11 +152,7 @@ pub fn load_checked(
 /// (`.`, `[` and `]` of the field path as `_`).
 #[must_use]
 pub fn default_out(loaded: &Loaded, param: &str) -> PathBuf {
-    PathBuf::from("results").join(format!(
-        "{}-sweep-{}",
-        loaded.name(),
-        param.replace(['.', '[', ']'], "_")
-    ))
+    crate::results::layout::default_sweep_dir(&loaded.name(), param)
 }
 
 /// The default quantum of bisection points: the step `dt` for a timing
@@ -209,9 +206,9 @@ fn run_one(
     interrupt: &Interrupt,
 ) -> Result<SweepRow, SweepError> {
     let loaded = scenario::load(&o.scenario, &overrides(&o.set, &o.param, value))?;
-    let name = format!("{k:03}-{}", value.replace(['/', ' ', '"'], "_"));
+    let name = crate::results::layout::sweep_run_name(k, value);
     let opts = RunOptions {
-        out: dir.join("runs").join(&name),
+        out: SweepLayout::new(dir).run(k, value).root().to_owned(),
         progress: false,
         ..o.run.clone()
     };
@@ -395,7 +392,8 @@ fn write_files(
             r.dir
         );
     }
-    let file = dir.join("sweep.csv");
+    let layout = SweepLayout::new(dir);
+    let file = layout.csv();
     std::fs::write(&file, csv).map_err(io_at(&file))?;
     let info = serde_json::json!({
         "param": o.param,
@@ -403,10 +401,10 @@ fn write_files(
         "margin": margin.map(|(lo, hi)| serde_json::json!({"largest_converging": lo, "smallest_failing": hi})),
     });
     let info = serde_json::to_string_pretty(&info).expect("json") + "\n";
-    let file = dir.join("sweep.json");
+    let file = layout.json();
     std::fs::write(&file, &info).map_err(io_at(&file))?;
-    plot(&dir.join("sweep.svg"), &o.param, rows).map_err(SweepError::Plot)?;
-    let file = dir.join(crate::results::staging::MARKER);
+    plot(&layout.svg(), &o.param, rows).map_err(SweepError::Plot)?;
+    let file = layout.summary();
     std::fs::write(&file, &info).map_err(io_at(&file))
 }
 

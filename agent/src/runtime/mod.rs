@@ -80,8 +80,8 @@ pub enum NodeError {
     #[error(transparent)]
     Open(#[from] OpenError),
     /// A port could not be created or used.
-    #[error("iceoryx2 port: {0}")]
-    Port(String),
+    #[error(transparent)]
+    Port(#[from] msgs::iox::IoxError),
     /// A bounded wait ran out.
     #[error("timed out after {waited:.1} s waiting for {what}")]
     Timeout {
@@ -126,8 +126,8 @@ pub enum NodeError {
     Stopped(u64),
 }
 
-pub(crate) fn port<E: std::fmt::Debug>(what: &str) -> impl FnOnce(E) -> NodeError + '_ {
-    move |e| NodeError::Port(format!("{what}: {e:?}"))
+pub(crate) fn port<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> NodeError {
+    move |e| NodeError::Port(msgs::iox::iox(what)(e))
 }
 
 /// Runs node `cfg.id` to the end of the protocol.

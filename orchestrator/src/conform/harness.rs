@@ -79,7 +79,7 @@ pub(super) fn session(
     let limits = Limits::of(net);
     let ports = Ports::open(ns, "conform", &limits, &[cfg.id])?;
     let wires = Wires::open(&ports, &cfg, &limits)?;
-    let file = ports.dir().join(format!("node-{}.json", cfg.id));
+    let file = (ports.dir()).join(crate::results::layout::node_config_file(cfg.id));
     cfg.write(&file)?;
     let mut cand = Candidate::start(opts, &file, true)?;
     let halt = Drive {

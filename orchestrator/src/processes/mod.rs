@@ -129,13 +129,20 @@ pub fn run(
     mut on_sample: impl FnMut(&Snapshot<'_>) -> bool,
 ) -> Result<Outcome, ProcessError> {
     let mut s = Session::open(net, opts, logs, interrupt)?;
+    tracing::debug!(nodes = net.agents.len() + 1, "processes: ports open, spawning");
     s.spawn_nodes()?;
+    tracing::debug!("processes: spawned, waiting for Ready");
     let failure = s
         .await_ready()
-        .and_then(|()| s.start())
+        .and_then(|()| {
+            tracing::debug!("processes: all ready, Start");
+            s.start()
+        })
         .and_then(|()| s.collect(&mut on_sample))
         .err()
         .map(|f| s.blame(f));
+    tracing::debug!(failure = ?failure, "processes: stepping over, shutting down");
     let failure = s.shutdown(failure);
+    tracing::debug!("processes: shut down, namespace removed");
     Ok(s.nodes.outcome(failure))
 }

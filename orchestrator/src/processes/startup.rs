@@ -55,7 +55,7 @@ impl<'a> Session<'a> {
 
     /// The log file of node index `i`.
     pub(super) fn log_of(&self, i: usize) -> PathBuf {
-        self.logs.join(format!("{}.log", self.nodes.slots[i].name))
+        (self.logs).join(crate::results::layout::node_log_file(&self.nodes.slots[i].name))
     }
 
     /// Writes every node's configuration and starts its process: a plug-in's
@@ -64,7 +64,7 @@ impl<'a> Session<'a> {
         let (agent_bin, leader_bin) = self.binaries.clone();
         let configs = node_configs(self.net, self.ports.run(), self.ports.dir(), self.opts);
         for (i, c) in configs.iter().enumerate() {
-            let file = self.ports.dir().join(format!("node-{}.json", c.id));
+            let file = (self.ports.dir()).join(crate::results::layout::node_config_file(c.id));
             c.write(&file).map_err(|e| ProcessError::Io {
                 path: file.clone(),
                 source: std::io::Error::other(e),

@@ -20,6 +20,7 @@ struct Cli {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    init_tracing();
     match commands::exec(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -31,6 +32,18 @@ fn main() -> ExitCode {
             ExitCode::from(e.exit_code())
         }
     }
+}
+
+/// Logs to stderr at the level of `ATTSYNC_LOG` (default `warn`; `debug`
+/// shows the phases of a run), as ARCHITECTURE.md's logging policy says.
+fn init_tracing() {
+    let filter = tracing_subscriber::EnvFilter::try_from_env("ATTSYNC_LOG")
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn"));
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_ansi(false)
+        .init();
 }
 
 #[cfg(test)]
