@@ -110,7 +110,11 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     check_options(loaded, opts)?;
     let mut process_opts = opts.processes.clone();
     process_opts.plugins = loaded.resolved.plugins.clone();
-    let staging = Staging::new(&opts.out).map_err(io_at(&opts.out))?;
+    let staging = Staging::claim(&opts.out).map_err(|e| match e {
+        // A foreign or busy --out: refused before anything started (exit 2).
+        e if e.is_refusal() => RunError::Options(OptionError::Conflict(e.to_string())),
+        e => io_at(&opts.out)(e.into()),
+    })?;
     let dir = staging.path().to_owned();
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
     std::fs::write(dir.join("scenario.toml"), text).map_err(io_at(&dir))?;
