@@ -73,7 +73,9 @@ impl OutLock {
                 file: Some(locked),
             });
         }
-        Err(LockError::Io(io::Error::other("the lock file keeps changing")))
+        Err(LockError::Io(io::Error::other(
+            "the lock file keeps changing",
+        )))
     }
 }
 

@@ -101,7 +101,10 @@ impl Staging {
     /// See [`StagingError`].
     pub fn claim(dest: &Path) -> Result<Self, StagingError> {
         let (parent, name) = layout::beside(dest).ok_or_else(|| {
-            at(dest)(io::Error::new(io::ErrorKind::InvalidInput, "output path has no name"))
+            at(dest)(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "output path has no name",
+            ))
         })?;
         fs::create_dir_all(parent).map_err(at(parent))?;
         let lock_path = OutLock::path_for(dest).expect("named");
@@ -129,7 +132,10 @@ impl Staging {
         fs::create_dir_all(&tmp).map_err(at(&tmp))?;
         let id = format!(
             "{}\n",
-            tmp.file_name().expect("named").to_string_lossy().trim_start_matches('.')
+            tmp.file_name()
+                .expect("named")
+                .to_string_lossy()
+                .trim_start_matches('.')
         );
         fs::write(tmp.join(MARKER), id).map_err(at(&tmp))?;
         Ok(Self {
@@ -188,9 +194,6 @@ fn foreign(dest: &Path) -> io::Result<Option<String>> {
     if names.is_empty() {
         return Ok(None);
     }
-    if !names.iter().any(|n| n == MARKER) {
-        return Ok(Some(format!("no {MARKER}")));
-    }
     let mut alien: Vec<String> = Vec::new();
     for n in &names {
         let path = dest.join(n);
@@ -207,13 +210,24 @@ fn foreign(dest: &Path) -> io::Result<Option<String>> {
             for e in fs::read_dir(&path)? {
                 let run = e?.path();
                 if let Some(why) = foreign(&run)? {
-                    alien.push(format!("{n}/{} ({why})", run.file_name().unwrap_or_default().to_string_lossy()));
+                    alien.push(format!(
+                        "{n}/{} ({why})",
+                        run.file_name().unwrap_or_default().to_string_lossy()
+                    ));
                 }
             }
         }
     }
     alien.sort();
-    Ok((!alien.is_empty()).then(|| format!("foreign file(s): {}", alien.join(", "))))
+    let list = format!("foreign file(s): {}", alien.join(", "));
+    Ok(
+        match (names.iter().any(|n| n == MARKER), alien.is_empty()) {
+            (true, true) => None,
+            (true, false) => Some(list),
+            (false, true) => Some(format!("no {MARKER}")),
+            (false, false) => Some(format!("no {MARKER}; {list}")),
+        },
+    )
 }
 
 /// Removes `.<name>.partial-<pid>` (and `.old`) directories in `parent`
@@ -271,7 +285,10 @@ mod tests {
         fs::create_dir_all(dest.join(layout::LOGS)).unwrap();
         fs::write(dest.join(layout::SUMMARY), "{}").unwrap();
         let err = Staging::claim(&dest).unwrap_err();
-        assert!(err.is_refusal() && err.to_string().contains(MARKER), "{err}");
+        assert!(
+            err.is_refusal() && err.to_string().contains(MARKER),
+            "{err}"
+        );
         fs::write(dest.join(MARKER), "old\n").unwrap();
         fs::write(dest.join("analysis.py"), "x").unwrap();
         fs::write(dest.join(layout::LOGS).join("notes.txt"), "x").unwrap();
@@ -298,7 +315,10 @@ mod tests {
         let first = Staging::claim(&dest).unwrap();
         assert!(!stale.exists());
         let err = Staging::claim(&dest).unwrap_err().to_string();
-        assert!(err.contains("another attsync run") && err.contains(".out.lock"), "{err}");
+        assert!(
+            err.contains("another attsync run") && err.contains(".out.lock"),
+            "{err}"
+        );
         first.commit().unwrap();
         assert_eq!(fs::read_dir(root.path()).unwrap().count(), 1);
     }
