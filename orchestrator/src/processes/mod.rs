@@ -5,6 +5,8 @@
 //! removes everything the run created.
 
 pub mod namespace;
+pub mod node_log;
+pub mod reaper;
 pub mod supervise;
 
 use crate::scenario::plugin::Plugin;
@@ -237,6 +239,7 @@ pub fn run(
         );
     }
 
+    let _reaper = reaper::Reaper::start(); // dropped after `sup`: kills the orphans
     let mut sup = Supervisor::new().map_err(io(Path::new("tokio runtime")))?;
     let log_of = |i: usize| logs.join(format!("{}.log", node_name(net, i)));
     for (i, c) in configs.iter().enumerate() {
