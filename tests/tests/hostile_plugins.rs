@@ -98,3 +98,27 @@ fn a_plugins_child_that_leaves_the_group_does_not_survive_the_run() {
     r.assert_code(1);
     assert!(left.is_empty(), "`sleep {secs}` left running: {left:?}");
 }
+
+#[test]
+fn a_long_tmpdir_does_not_break_the_processes_engine() {
+    let tmp = Sandbox::new("hostile-tmpdir");
+    let name = "t".repeat(100 - tmp.path().as_os_str().len() - 1);
+    let long = tmp.join(name);
+    assert_eq!(long.as_os_str().len(), 100);
+    std::fs::create_dir(&long).unwrap();
+    let out = tmp.join("out");
+    let args = run_args(
+        &paper("timevarying"),
+        "processes",
+        &out,
+        &["simulation.duration=0.2"],
+    );
+    let r = Attsync::new(tmp.path())
+        .env("TMPDIR", &long.display().to_string())
+        .args(args)
+        .output();
+    r.assert_ok();
+    assert_eq!(summary(&out)["complete"], true);
+    // The namespace went to /tmp, and nothing was left in the long TMPDIR.
+    assert_eq!(std::fs::read_dir(&long).unwrap().count(), 0);
+}
