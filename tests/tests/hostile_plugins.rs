@@ -4,7 +4,7 @@
 //! the process group (killed at the end of the run: nothing survives it).
 
 use attsync_tests::{Attsync, Finished, Sandbox, paper, read, run_args, summary};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The observerless paper scenario with agent 3 replaced by `sh -c SCRIPT`.
 fn with_plugin(tmp: &Sandbox, name: &str, script: &str) -> PathBuf {
@@ -18,7 +18,7 @@ fn with_plugin(tmp: &Sandbox, name: &str, script: &str) -> PathBuf {
 }
 
 /// Runs `scenario` (processes engine, 5 s, stage timeout 2 s) into `out`.
-fn run(tmp: &Sandbox, scenario: &PathBuf, out: &PathBuf) -> Finished {
+fn run(tmp: &Sandbox, scenario: &Path, out: &Path) -> Finished {
     let mut args = run_args(scenario, "processes", out, &["simulation.duration=5"]);
     args.extend(["--stage-timeout".into(), "2".into()]);
     Attsync::new(tmp.path()).args(args).output()
