@@ -179,3 +179,19 @@ fn tracing_free_log(msg: &str) {
         eprintln!("attsync: {msg}");
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_base_too_long_for_socket_paths_is_refused_naming_tmpdir() {
+        assert!(check_base(Path::new("/tmp/attsync-iox2")).is_ok());
+        let long = PathBuf::from(format!("/{}/attsync-iox2", "t".repeat(40)));
+        let e = check_base(&long).unwrap_err().to_string();
+        assert!(
+            e.contains("TMPDIR is too long") && e.contains("at most 27 bytes"),
+            "{e}"
+        );
+    }
+}
