@@ -110,7 +110,11 @@ fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<Summary, RunError> {
     opts.validate()?;
     check_options(loaded, opts)?;
-    let staging = Staging::new(&opts.out).map_err(io_at(&opts.out))?;
+    let staging = Staging::claim(&opts.out).map_err(|e| match e {
+        // A foreign or busy --out: refused before anything started (exit 2).
+        e if e.is_refusal() => RunError::Options(OptionError::Conflict(e.to_string())),
+        e => io_at(&opts.out)(e.into()),
+    })?;
     tracing::debug!(staging = %staging.path().display(), engine = opts.engine.name(), "run: staged");
     let layout = RunLayout::new(staging.path());
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");

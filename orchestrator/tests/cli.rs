@@ -25,7 +25,8 @@ const OBSERVERLESS: &str = concat!(
     "/../scenarios/paper/constant-observerless.toml"
 );
 const HEADER: &str = "t,agent,att_err,angvel_err,obs_att_err,obs_angvel_err";
-const RESULT_FILES: [&str; 5] = [
+const RESULT_FILES: [&str; 6] = [
+    ".attsync-run",
     "errors.csv",
     "errors.svg",
     "scenario.toml",

@@ -24,7 +24,9 @@ mod blame;
 mod collect;
 mod configs;
 pub mod namespace;
+pub mod node_log;
 pub mod ports;
+pub mod reaper;
 mod shutdown;
 mod startup;
 pub mod supervise;
@@ -128,6 +130,9 @@ pub fn run(
     interrupt: &AtomicBool,
     mut on_sample: impl FnMut(&Snapshot<'_>) -> bool,
 ) -> Result<Outcome, ProcessError> {
+    // Declared first, dropped last (after the session's supervisor): kills
+    // whatever a plug-in left behind outside its process group.
+    let _reaper = reaper::Reaper::start();
     let mut s = Session::open(net, opts, logs, interrupt)?;
     tracing::debug!(nodes = net.agents.len() + 1, "processes: ports open, spawning");
     s.spawn_nodes()?;

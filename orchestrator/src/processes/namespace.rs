@@ -17,10 +17,51 @@ pub struct Namespace {
     dir: PathBuf,
 }
 
-/// Parent directory of every run's namespace.
+/// The name of the directory, in the temporary directory, of every run's namespace.
+const BASE_NAME: &str = "attsync-iox2";
+
+/// Longest [`base_dir`] path, in bytes: iceoryx2's Unix socket paths
+/// (`<base>/<run>/<prefix><service>…`) must fit in 108 bytes (`sun_path`),
+/// and a run id takes up to 15.
+pub const MAX_BASE_LEN: usize = 40;
+
+/// Parent directory of every run's namespace: `$TMPDIR/attsync-iox2`, or
+/// `/tmp/attsync-iox2` if that is longer than [`MAX_BASE_LEN`] (said with
+/// `ATTSYNC_DEBUG`) and `/tmp` is writable.
 #[must_use]
 pub fn base_dir() -> PathBuf {
-    std::env::temp_dir().join("attsync-iox2")
+    let base = std::env::temp_dir().join(BASE_NAME);
+    if base.as_os_str().len() <= MAX_BASE_LEN {
+        return base;
+    }
+    let short = Path::new("/tmp").join(BASE_NAME);
+    if fs::create_dir_all(&short).is_ok() {
+        tracing_free_log(&format!(
+            "{} is longer than {MAX_BASE_LEN} bytes (too long for Unix socket paths): using {}",
+            base.display(),
+            short.display()
+        ));
+        return short;
+    }
+    base
+}
+
+/// An error if `base` (from [`base_dir`]) is too long for socket paths.
+fn check_base(base: &Path) -> std::io::Result<()> {
+    if base.as_os_str().len() <= MAX_BASE_LEN {
+        return Ok(());
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!(
+            "TMPDIR is too long: the namespace directory {} has {} bytes, at most {MAX_BASE_LEN} \
+             fit in Unix socket paths (108 bytes), and /tmp is not writable; set TMPDIR to a \
+             shorter directory (at most {} bytes)",
+            base.display(),
+            base.as_os_str().len(),
+            MAX_BASE_LEN - BASE_NAME.len() - 1
+        ),
+    ))
 }
 
 impl Namespace {
@@ -42,6 +83,7 @@ impl Namespace {
         // rename it into place, so that another attsync's stale-namespace
         // sweep never sees a namespace without an owner.
         let base = base_dir();
+        check_base(&base)?;
         fs::create_dir_all(&base)?;
         let tmp = base.join(format!(".{run}.creating"));
         fs::create_dir_all(&tmp)?;
@@ -135,5 +177,21 @@ pub fn remove_stale() {
 fn tracing_free_log(msg: &str) {
     if std::env::var_os("ATTSYNC_DEBUG").is_some() {
         eprintln!("attsync: {msg}");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_base_too_long_for_socket_paths_is_refused_naming_tmpdir() {
+        assert!(check_base(Path::new("/tmp/attsync-iox2")).is_ok());
+        let long = PathBuf::from(format!("/{}/attsync-iox2", "t".repeat(40)));
+        let e = check_base(&long).unwrap_err().to_string();
+        assert!(
+            e.contains("TMPDIR is too long") && e.contains("at most 27 bytes"),
+            "{e}"
+        );
     }
 }

@@ -1,10 +1,11 @@
 //! Process supervision with tokio: start the node processes (each in its own
-//! process group, output to its log file), report every exit as soon as it
-//! happens, kill them all on demand. The engine polls it ([`Supervisor::try_exit`]);
-//! `conform` waits on it ([`Supervisor::next_exit`]) and keeps a candidate's
-//! process group after it exits, to check it is empty ([`Supervisor::keep_groups`],
-//! [`group_members`]).
+//! process group, output piped into its capped log file, [`super::node_log`]),
+//! report every exit as soon as it happens, kill them all on demand. The
+//! engine polls it ([`Supervisor::try_exit`]); `conform` waits on it
+//! ([`Supervisor::next_exit`]) and keeps a candidate's process group after it
+//! exits, to check it is empty ([`Supervisor::keep_groups`], [`group_members`]).
 
+use super::node_log;
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
 use std::process::{ExitStatus, Stdio};
@@ -91,8 +92,9 @@ impl Supervisor {
     }
 
     /// Starts `program args…` as node `index` (with `env` added to the
-    /// environment, in `cwd` if given), stdout and stderr to `log`. Returns
-    /// its process id, or `None` if it could not start (its [`Exit`] says why).
+    /// environment, in `cwd` if given), stdout and stderr piped into `log`
+    /// (cut at [`super::node_log::LOG_CAP`]). Returns its process id, or
+    /// `None` if it could not start (its [`Exit`] says why).
     pub fn spawn(
         &mut self,
         index: usize,
@@ -102,8 +104,7 @@ impl Supervisor {
         cwd: Option<&Path>,
         log: &Path,
     ) -> std::io::Result<Option<u32>> {
-        let out = std::fs::File::create(log)?;
-        let err = out.try_clone()?;
+        let log = std::fs::File::create(log)?;
         let mut cmd = tokio::process::Command::new(program);
         if let Some(dir) = cwd {
             cmd.current_dir(dir);
@@ -111,8 +112,8 @@ impl Supervisor {
         cmd.args(args)
             .envs(env.iter().map(|(k, v)| (k, v)))
             .stdin(Stdio::null())
-            .stdout(out)
-            .stderr(err)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
             .process_group(0)
             .kill_on_drop(true);
         let tx = self.exits_tx.clone();
@@ -123,8 +124,12 @@ impl Supervisor {
         let pid = spawned.as_ref().ok().and_then(tokio::process::Child::id);
         let keep_groups = self.keep_groups;
         self.rt.spawn(async move {
-            let mut child = match spawned {
-                Ok(c) => c,
+            let (mut child, copy) = match spawned {
+                Ok(mut c) => {
+                    let (out, err) = (c.stdout.take(), c.stderr.take());
+                    let copy = node_log::copy_capped(out, err, log, node_log::LOG_CAP);
+                    (c, tokio::spawn(copy))
+                }
                 Err(e) => {
                     let _ = tx.send(Exit {
                         index,
@@ -149,6 +154,9 @@ impl Supervisor {
             if killed || !keep_groups {
                 kill_group(pgid);
             }
+            // The log is complete once the pipes close (unless something that
+            // left the group still holds them).
+            let _ = tokio::time::timeout(Duration::from_secs(2), copy).await;
             let _ = tx.send(Exit {
                 index,
                 status: status.map_err(|e| e.to_string()),
@@ -250,13 +258,7 @@ pub fn group_members(pgid: u32) -> Vec<u32> {
         .collect()
 }
 
-/// The last `n` lines of a log file (empty if unreadable).
-#[must_use]
-pub fn tail(log: &Path, n: usize) -> String {
-    let text = std::fs::read_to_string(log).unwrap_or_default();
-    let lines: Vec<&str> = text.lines().collect();
-    lines[lines.len().saturating_sub(n)..].join("\n")
-}
+pub use super::node_log::tail;
 
 /// Paths of the node binaries, found beside the running executable (or in
 /// `ATTSYNC_BIN_DIR`).

@@ -4,23 +4,28 @@
 //!
 //! ```text
 //! results/<scenario>/             a run (`attsync run`, default --out)
-//!   summary.json                  the results (also marks the directory as attsync results)
+//!   .attsync-run                  marker: the directory is attsync's (holds the run id)
+//!   summary.json                  the results
 //!   errors.csv                    error time series, one row per agent per sample
 //!   errors.svg                    plot of errors.csv
 //!   states.bin                    full state trajectory (see `states`)
 //!   scenario.toml                 the scenario as run (copied)
 //!   logs/<node>.log               processes engine: leader.log, agent-<id>.log
 //! results/<scenario>-sweep-<param>/   a sweep (`attsync sweep`, default --out)
-//!   summary.json                  marker (same content as sweep.json)
+//!   .attsync-run  summary.json    marker; summary.json has the content of sweep.json
 //!   sweep.csv  sweep.json  sweep.svg
 //!   runs/<k>-<value>/             one run each (the run layout above)
 //! .<name>.partial-<pid>/          staging directory beside `<name>` while it is written
 //! .<name>.partial-<pid>.old/      the replaced results, while the new ones move in
+//! .<name>.lock                    held (flock) by the run writing `<name>`; removed after
 //! <tmp>/attsync-iox2/<run>/node-<id>.json   a node's configuration (processes engine)
 //! ```
 
 use std::path::{Path, PathBuf};
 
+/// `.attsync-run`: marks a directory as attsync results (holds the run id);
+/// only a directory holding it, and nothing but [`OWNED`], is ever replaced.
+pub const MARKER: &str = ".attsync-run";
 /// `summary.json`: a run's results, or a sweep's marker.
 pub const SUMMARY: &str = "summary.json";
 /// `errors.csv`.
@@ -43,6 +48,12 @@ pub const SWEEP_SVG: &str = "sweep.svg";
 pub const RUNS: &str = "runs";
 /// Default parent of results directories (relative to the working directory).
 pub const RESULTS: &str = "results";
+
+/// Every name attsync writes at the top of a run's or a sweep's directory.
+pub const OWNED: [&str; 11] = [
+    MARKER, SUMMARY, ERRORS_CSV, ERRORS_SVG, STATES, SCENARIO, LOGS, SWEEP_CSV, SWEEP_JSON,
+    SWEEP_SVG, RUNS,
+];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
 #[must_use]
@@ -70,6 +81,20 @@ pub fn node_config_file(id: u32) -> String {
 #[must_use]
 pub fn staging_name(name: &str, pid: u32) -> String {
     format!(".{name}.partial-{pid}")
+}
+
+/// The pid in `name` if it is a staging directory of `<dest_name>`
+/// (`.<dest_name>.partial-<pid>`, or that with `.old`).
+#[must_use]
+pub fn staging_pid(dest_name: &str, name: &str) -> Option<u32> {
+    let rest = name.strip_prefix(&format!(".{dest_name}.partial-"))?;
+    rest.strip_suffix(".old").unwrap_or(rest).parse().ok()
+}
+
+/// `.<name>.lock`: the lock file of results directory `<name>`.
+#[must_use]
+pub fn lock_name(name: &str) -> String {
+    format!(".{name}.lock")
 }
 
 /// `<staging>.old`: where the replaced results wait while the new ones move in.
@@ -225,6 +250,18 @@ impl SweepLayout {
     }
 }
 
+/// `dest`'s parent (`.` for a bare name), where its staging directories and
+/// lock file live (`None` if `dest` has no file name).
+#[must_use]
+pub fn beside(dest: &Path) -> Option<(&Path, String)> {
+    let name = dest.file_name()?.to_string_lossy().into_owned();
+    let parent = dest
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    Some((parent, name))
+}
+
 /// The staging directory beside `dest` that process `pid` writes it in:
 /// `.<name>.partial-<pid>` (`None` if `dest` has no file name).
 #[must_use]
@@ -259,6 +296,10 @@ mod tests {
             Some(PathBuf::from("./.out.partial-42"))
         );
         assert_eq!(replaced_name(".out.partial-42"), ".out.partial-42.old");
+        assert_eq!(staging_pid("out", ".out.partial-42"), Some(42));
+        assert_eq!(staging_pid("out", ".out.partial-42.old"), Some(42));
+        assert_eq!(staging_pid("out", ".other.partial-42"), None);
+        assert_eq!(lock_name("out"), ".out.lock");
         assert_eq!(SweepLayout::run_rel(4, "a b/\"c\""), "runs/004-a_b__c_");
         assert_eq!(
             SweepLayout::new("s").run(4, "0.5").root(),

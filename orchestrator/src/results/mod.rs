@@ -10,9 +10,12 @@
 //! - [`summary`]: `summary.json` ([`Summary`]) and the end-of-run table.
 //! - [`states`]: `states.bin`, its byte layout, reader and CSV export.
 //! - [`plot`]: draws `errors.svg`.
-//! - [`staging`]: the atomic results directory (`.NAME.partial-PID`).
+//! - [`staging`]: the atomic results directory (`.NAME.partial-PID`), replacing
+//!   only a directory marked as attsync's.
+//! - [`lock`]: the lock (`.NAME.lock`) serialising runs into one directory.
 
 pub mod layout;
+pub mod lock;
 pub mod plot;
 pub mod staging;
 pub mod states;

@@ -1,0 +1,131 @@
+//! A node's log: its stdout and stderr, piped through the orchestrator into
+//! `logs/<node>.log` and cut at [`LOG_CAP`] (past it one [`CUT_LINE`] is
+//! written and the rest drained, so the node never blocks on a full pipe);
+//! [`tail`] reads only the end of a log.
+
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::Path;
+use tokio::io::AsyncReadExt;
+use tokio::process::{ChildStderr, ChildStdout};
+
+/// Most bytes of a node's output kept in its log.
+pub const LOG_CAP: u64 = 16 << 20;
+/// The line that ends a log cut at [`LOG_CAP`].
+pub const CUT_LINE: &str = "[attsync: log cut at 16 MiB; further output discarded]";
+/// How much of the end of a log [`tail`] reads.
+const TAIL_BYTES: u64 = 64 << 10;
+
+/// A log file that takes at most `cap` bytes of output.
+#[derive(Debug)]
+struct CappedLog {
+    file: File,
+    written: u64,
+    cap: u64,
+    cut: bool,
+}
+
+impl CappedLog {
+    fn write(&mut self, data: &[u8]) {
+        if self.cut {
+            return;
+        }
+        let room = usize::try_from(self.cap - self.written).unwrap_or(usize::MAX);
+        let keep = &data[..data.len().min(room)];
+        // A log that cannot be written is not a reason to stop the node.
+        let _ = self.file.write_all(keep);
+        self.written += keep.len() as u64;
+        if keep.len() < data.len() {
+            let _ = writeln!(self.file, "\n{CUT_LINE}");
+            self.cut = true;
+        }
+    }
+}
+
+/// Copies `out` and `err` into `log` (at most `cap` bytes, then
+/// [`CUT_LINE`]) until both are closed, draining whatever comes after the cap.
+pub async fn copy_capped(
+    mut out: Option<ChildStdout>,
+    mut err: Option<ChildStderr>,
+    log: File,
+    cap: u64,
+) {
+    let mut log = CappedLog {
+        file: log,
+        written: 0,
+        cap,
+        cut: false,
+    };
+    let (mut bo, mut be) = (vec![0u8; 16 << 10], vec![0u8; 16 << 10]);
+    while out.is_some() || err.is_some() {
+        tokio::select! {
+            r = async { out.as_mut().expect("open").read(&mut bo).await }, if out.is_some() => {
+                match r {
+                    Ok(n) if n > 0 => log.write(&bo[..n]),
+                    _ => out = None,
+                }
+            }
+            r = async { err.as_mut().expect("open").read(&mut be).await }, if err.is_some() => {
+                match r {
+                    Ok(n) if n > 0 => log.write(&be[..n]),
+                    _ => err = None,
+                }
+            }
+        }
+    }
+}
+
+/// The last `n` lines of a log file, read from at most its last 64 KiB and
+/// decoded lossily (empty if unreadable).
+#[must_use]
+pub fn tail(log: &Path, n: usize) -> String {
+    let Ok(mut file) = File::open(log) else {
+        return String::new();
+    };
+    let len = file.metadata().map_or(0, |m| m.len());
+    let start = len.saturating_sub(TAIL_BYTES);
+    let mut bytes = Vec::new();
+    if file.seek(SeekFrom::Start(start)).is_err() || file.read_to_end(&mut bytes).is_err() {
+        return String::new();
+    }
+    let text = String::from_utf8_lossy(&bytes);
+    let mut lines: Vec<&str> = text.lines().collect();
+    if start > 0 && !lines.is_empty() {
+        lines.remove(0); // cut in the middle
+    }
+    lines[lines.len().saturating_sub(n)..].join("\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_log_is_cut_once_at_the_cap() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.log");
+        let mut log = CappedLog {
+            file: File::create(&path).unwrap(),
+            written: 0,
+            cap: 10,
+            cut: false,
+        };
+        log.write(b"12345678");
+        log.write(b"abcdef");
+        log.write(b"more");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text, format!("12345678ab\n{CUT_LINE}\n"));
+        assert_eq!(tail(&path, 1), CUT_LINE);
+    }
+
+    #[test]
+    fn tail_reads_the_end_lossily() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.log");
+        let mut data = b"head\n".repeat(40_000);
+        data.extend_from_slice(b"bad \xff\xfe bytes\nlast\n");
+        std::fs::write(&path, data).unwrap();
+        assert_eq!(tail(&path, 2), "bad \u{fffd}\u{fffd} bytes\nlast");
+        assert!(tail(&path, 100_000).lines().count() < 14_000);
+    }
+}
