@@ -10,9 +10,9 @@
 //! invalid `--set`); bisection points are rounded to a quantum, by default
 //! the step `simulation.dt` for a timing field ([`default_quantum`]).
 
-use crate::results::layout::SweepLayout;
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
+use crate::results::layout::SweepLayout;
 use crate::results::staging::Staging;
 use crate::run::{RunError, RunOptions, run};
 use crate::scenario::{self, Loaded, ScenarioError};

@@ -134,7 +134,10 @@ pub fn run(
     // whatever a plug-in left behind outside its process group.
     let _reaper = reaper::Reaper::start();
     let mut s = Session::open(net, opts, logs, interrupt)?;
-    tracing::debug!(nodes = net.agents.len() + 1, "processes: ports open, spawning");
+    tracing::debug!(
+        nodes = net.agents.len() + 1,
+        "processes: ports open, spawning"
+    );
     s.spawn_nodes()?;
     tracing::debug!("processes: spawned, waiting for Ready");
     let failure = s

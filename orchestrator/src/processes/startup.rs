@@ -55,7 +55,9 @@ impl<'a> Session<'a> {
 
     /// The log file of node index `i`.
     pub(super) fn log_of(&self, i: usize) -> PathBuf {
-        (self.logs).join(crate::results::layout::node_log_file(&self.nodes.slots[i].name))
+        (self.logs).join(crate::results::layout::node_log_file(
+            &self.nodes.slots[i].name,
+        ))
     }
 
     /// Writes every node's configuration and starts its process: a plug-in's
