@@ -149,7 +149,7 @@ fn the_independent_agent_conforms() {
         .args([agent_py()])
         .output();
     r.assert_ok();
-    assert!(r.stdout.contains("9/9 rules pass"), "{}", r.describe());
+    assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
 }
 
 #[test]

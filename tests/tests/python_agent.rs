@@ -42,7 +42,7 @@ fn the_python_agent_conforms() {
         .args([agent_py()])
         .output();
     r.assert_ok();
-    assert!(r.stdout.contains("9/9 rules pass"), "{}", r.describe());
+    assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
 }
 
 #[test]
@@ -112,7 +112,7 @@ fn conforms_in(neighbourhood: &str) {
         .args([agent_py()])
         .output();
     r.assert_ok();
-    assert!(r.stdout.contains("9/9 rules pass"), "{}", r.describe());
+    assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
 }
 
 #[test]
