@@ -5,8 +5,7 @@
 use super::collect::Collector;
 use super::supervise::{describe, tail};
 use super::{Failure, Session};
-use attitude::network::Network;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 impl Session<'_> {
     /// A node that exited before it was done is a failure: name it, its
@@ -28,23 +27,39 @@ impl Session<'_> {
         None
     }
 
-    /// `failure`, with the nodes others gave up waiting for named first
-    /// (after a moment for their last telemetry to arrive).
+    /// `failure`, with the nodes others gave up waiting for named first.
+    /// The last reports may come a little after the first failure (a node
+    /// held back by a silent receiver gives up when its back-pressure wait
+    /// ends, just after its own receivers): wait until the telemetry is
+    /// quiet for [`QUIET`], at most [`SETTLE`].
     pub(super) fn blame(&mut self, failure: Failure) -> Failure {
-        std::thread::sleep(Duration::from_millis(20));
-        let _ = self.nodes.drain(&self.ports);
-        match self.nodes.blame(self.net) {
+        let end = Instant::now() + SETTLE;
+        let mut quiet_since = Instant::now();
+        while Instant::now() < end && quiet_since.elapsed() < QUIET {
+            std::thread::sleep(Duration::from_millis(10));
+            if let Ok(true) = self.nodes.drain(&self.ports) {
+                quiet_since = Instant::now();
+            }
+        }
+        match self.nodes.blame() {
             Some(b) => format!("{b}\n{failure}"),
             None => failure,
         }
     }
 }
 
+/// Longest wait for the last reports before naming the culprit.
+const SETTLE: Duration = Duration::from_secs(1);
+/// Telemetry silent this long: every report that will come has come.
+const QUIET: Duration = Duration::from_millis(200);
+
 impl Collector {
-    /// Names the nodes others gave up waiting for, if any did.
-    pub(crate) fn blame(&self, net: &Network) -> Option<String> {
-        // Node index: 0 the leader, 1 + the agent's index.
-        let index_of = |id: u32| net.index_of(id).map_or(0, |i| i + 1);
+    /// Names the nodes others gave up waiting for, if any did: first the
+    /// ones that did not give up waiting themselves (the root of a lockstep
+    /// cascade), the leader last (it has no inputs: in lockstep it stalls
+    /// only when a receiver stops reading, i.e. by back-pressure).
+    pub(crate) fn blame(&self) -> Option<String> {
+        let index_of = |id: u32| self.slots.iter().position(|s| s.id == id).unwrap_or(0);
         let mut blamed: Vec<u32> = self.blamed.iter().map(|&(_, id)| id).collect();
         blamed.sort_unstable();
         blamed.dedup();
@@ -56,7 +71,10 @@ impl Collector {
             .copied()
             .filter(|&id| !self.slots[index_of(id)].gave_up)
             .collect();
-        let silent = if roots.is_empty() { blamed } else { roots };
+        let mut silent = if roots.is_empty() { blamed } else { roots };
+        // Ids ascend, so the leader (0) is first: put it last.
+        let leader_first = silent.first() == Some(&0) && silent.len() > 1;
+        silent.rotate_left(usize::from(leader_first));
         let lines: Vec<String> = silent
             .iter()
             .map(|&id| self.blame_line(id, &self.slots[index_of(id)].label))
@@ -81,5 +99,52 @@ impl Collector {
                 waiters.join(", ")
             )
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::collect::NodeSlot;
+    use super::*;
+
+    fn three_nodes() -> Collector {
+        Collector::new(vec![
+            NodeSlot::new("leader".into(), "leader".into(), 0),
+            NodeSlot::new("agent-1".into(), "agent-1".into(), 1),
+            NodeSlot::new("agent-3".into(), "agent-3 (plug-in `x`)".into(), 3),
+        ])
+    }
+
+    #[test]
+    fn the_node_that_did_not_wait_itself_is_named_before_the_leader() {
+        let mut c = three_nodes();
+        // agent-1 timed out on the leader (stalled by back-pressure, its
+        // report not in yet) and on agent-3 (hung).
+        c.blamed = vec![(1, 0), (1, 3)];
+        c.slots[1].gave_up = true;
+        let b = c.blame().expect("someone is blamed");
+        assert!(b.starts_with("agent-3 (plug-in `x`) stopped answering"), "{b}");
+        assert!(b.lines().nth(1).is_some_and(|l| l.starts_with("leader")), "{b}");
+    }
+
+    #[test]
+    fn a_leader_that_gave_up_is_not_a_root() {
+        let mut c = three_nodes();
+        c.blamed = vec![(1, 0), (2, 0), (1, 3)];
+        c.slots[0].gave_up = true;
+        c.slots[1].gave_up = true;
+        let b = c.blame().expect("someone is blamed");
+        assert_eq!(b.lines().count(), 1, "{b}");
+        assert!(b.starts_with("agent-3"), "{b}");
+    }
+
+    #[test]
+    fn a_hung_leader_alone_is_named() {
+        let mut c = three_nodes();
+        c.blamed = vec![(1, 0), (2, 0)];
+        c.slots[1].gave_up = true;
+        c.slots[2].gave_up = true;
+        let b = c.blame().expect("someone is blamed");
+        assert!(b.starts_with("leader stopped answering: agent-1, agent-3"), "{b}");
     }
 }

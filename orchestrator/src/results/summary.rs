@@ -9,8 +9,10 @@ pub struct AgentSummary {
     /// Agent id.
     pub id: u32,
     /// `|Rᵢ R₀ᵀ|_I` at the last sample.
+    #[serde(deserialize_with = "f64_or_nan")]
     pub final_att_err: f64,
     /// `‖ωᵢ − ω₀‖` at the last sample, rad/s.
+    #[serde(deserialize_with = "f64_or_nan")]
     pub final_angvel_err: f64,
     /// Observer attitude error at the last sample (schemes 1–2).
     pub final_obs_att_err: Option<f64>,
@@ -23,6 +25,7 @@ pub struct AgentSummary {
     #[serde(rename = "settle_time_1e-6")]
     pub settle_time_1e6: Option<f64>,
     /// Largest `‖τᵢ‖` applied at the start of any step, N·m.
+    #[serde(deserialize_with = "f64_or_nan")]
     pub peak_torque: f64,
     /// Real-time mode: stages the agent started more than one step late.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -51,8 +54,10 @@ pub struct LinkSummary {
     /// Messages lost.
     pub lost: u64,
     /// Mean age of information of the value the receiver used, over its stages, s.
+    #[serde(deserialize_with = "f64_or_nan")]
     pub aoi_mean: f64,
     /// Largest age of information, s.
+    #[serde(deserialize_with = "f64_or_nan")]
     pub aoi_max: f64,
     /// Messages the receiver refused (non-finite values, or an attitude that
     /// is not a rotation); it kept its previous value instead.
@@ -84,6 +89,7 @@ pub struct Summary {
     /// Wall-clock time of the simulation, s (not deterministic).
     pub wall_seconds: f64,
     /// Largest final `att_err` over agents.
+    #[serde(deserialize_with = "f64_or_nan")]
     pub max_final_att_err: f64,
     /// Per agent, ascending id.
     pub agents: Vec<AgentSummary>,
@@ -145,6 +151,11 @@ impl NodeSummary {
             done_unix_ns: d.done_unix_ns,
         }
     }
+}
+
+/// `summary.json` holds a NaN (a diverged state) as `null`: read it back as NaN.
+fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// Time after which `err` stays below `threshold`: the sample after the last
@@ -222,6 +233,33 @@ impl Summary {
             }
         );
         s
+    }
+}
+
+#[cfg(test)]
+mod nan_tests {
+    use super::*;
+
+    #[test]
+    fn a_nan_written_as_null_reads_back_as_nan() {
+        let a = AgentSummary {
+            id: 1,
+            final_att_err: f64::NAN,
+            final_angvel_err: 0.5,
+            final_obs_att_err: None,
+            final_obs_angvel_err: None,
+            settle_time_1e3: None,
+            settle_time_1e6: None,
+            peak_torque: f64::NAN,
+            late_stages: None,
+            max_lateness: None,
+            plugin: None,
+        };
+        let text = serde_json::to_string(&a).unwrap();
+        assert!(text.contains("\"final_att_err\":null"), "{text}");
+        let b: AgentSummary = serde_json::from_str(&text).unwrap();
+        assert!(b.final_att_err.is_nan() && b.peak_torque.is_nan());
+        assert_eq!(b.final_angvel_err, 0.5);
     }
 }
 
