@@ -219,8 +219,8 @@ impl Summary {
             "{}{mode} run of {}: t = {} s of {} s ({} steps, {:.2} s wall){}",
             self.engine,
             self.scenario,
-            self.t_end,
-            self.duration,
+            super::fmt_time(self.steps, self.dt),
+            super::fmt_time((self.duration / self.dt).round() as u64, self.dt),
             self.steps,
             self.wall_seconds,
             if self.complete {
