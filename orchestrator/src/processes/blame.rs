@@ -123,8 +123,14 @@ mod tests {
         c.blamed = vec![(1, 0), (1, 3)];
         c.slots[1].gave_up = true;
         let b = c.blame().expect("someone is blamed");
-        assert!(b.starts_with("agent-3 (plug-in `x`) stopped answering"), "{b}");
-        assert!(b.lines().nth(1).is_some_and(|l| l.starts_with("leader")), "{b}");
+        assert!(
+            b.starts_with("agent-3 (plug-in `x`) stopped answering"),
+            "{b}"
+        );
+        assert!(
+            b.lines().nth(1).is_some_and(|l| l.starts_with("leader")),
+            "{b}"
+        );
     }
 
     #[test]
@@ -145,6 +151,9 @@ mod tests {
         c.slots[1].gave_up = true;
         c.slots[2].gave_up = true;
         let b = c.blame().expect("someone is blamed");
-        assert!(b.starts_with("leader stopped answering: agent-1, agent-3"), "{b}");
+        assert!(
+            b.starts_with("leader stopped answering: agent-1, agent-3"),
+            "{b}"
+        );
     }
 }
