@@ -1,38 +1,76 @@
 //! Waiting strategies for a stage's inputs (see [`WaitStrategy`]).
+//!
+//! `Adaptive`, the default, is built for a machine that may be shared:
+//! - while the cores are ours it yields between polls, for at most
+//!   [`YIELD_WINDOW`] of elapsed time per wait, then blocks;
+//! - a yield that comes back only after [`STOLEN`] shows that another program
+//!   got the core for a time slice (a yield hands the core to whoever is
+//!   runnable, and a CPU-bound competitor keeps it for its whole slice). From
+//!   then on the waiter blocks at once, for [`CONTENDED_HOLD`], and then tries
+//!   yielding again.
+//!
+//! Blocking sleeps on the node's wake event in slices of [`BLOCK_SLICE`] and
+//! the caller re-polls its subscribers after every wake, timeout or not, so
+//! a wake-up that never comes costs one slice, never a stall.
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::service::Service;
 use msgs::config::WaitStrategy;
 use std::time::{Duration, Instant};
 
-/// Yields before an adaptive waiter starts to block.
-const ADAPTIVE_YIELDS: u32 = 200;
-/// Longest single sleep on the wake event: a lost wake-up costs at most this.
-const BLOCK_SLICE: Duration = Duration::from_millis(1);
+/// Longest an adaptive waiter yields in one wait before it blocks.
+pub const YIELD_WINDOW: Duration = Duration::from_micros(500);
+/// A yield that takes longer than this lost the core to another program.
+pub const STOLEN: Duration = Duration::from_millis(1);
+/// How long an adaptive waiter blocks at once after a stolen yield.
+pub const CONTENDED_HOLD: Duration = Duration::from_secs(1);
+/// Longest single sleep on the wake event.
+pub const BLOCK_SLICE: Duration = Duration::from_millis(1);
 
 /// Applies a [`WaitStrategy`] between polls.
 #[derive(Debug)]
 pub struct Waiter {
     strategy: WaitStrategy,
     polls: u32,
+    /// When the current wait episode began (adaptive only).
+    began: Instant,
+    /// Adaptive: block at once until then (the cores are shared).
+    contended_until: Option<Instant>,
+    /// Times a yield was stolen (adaptive), for the node's report.
+    stolen: u64,
 }
 
 impl Waiter {
     /// A waiter with `strategy`.
     #[must_use]
     pub fn new(strategy: WaitStrategy) -> Self {
-        Self { strategy, polls: 0 }
+        Self {
+            strategy,
+            polls: 0,
+            began: Instant::now(),
+            contended_until: None,
+            stolen: 0,
+        }
     }
 
     /// Starts a new wait episode (a new stage's inputs).
     pub fn begin(&mut self) {
         self.polls = 0;
+        if self.strategy == WaitStrategy::Adaptive {
+            self.began = Instant::now();
+        }
     }
 
     /// Polls in the current episode.
     #[must_use]
     pub fn polls(&self) -> u32 {
         self.polls
+    }
+
+    /// How many times an adaptive waiter found its core taken by another program.
+    #[must_use]
+    pub fn stolen(&self) -> u64 {
+        self.stolen
     }
 
     /// Whether peers using this strategy may sleep, so senders must notify.
@@ -49,19 +87,44 @@ impl Waiter {
             WaitStrategy::Spin => std::hint::spin_loop(),
             WaitStrategy::Yield => std::thread::yield_now(),
             WaitStrategy::Block => block(listener),
-            WaitStrategy::Adaptive => {
-                if self.polls <= ADAPTIVE_YIELDS {
-                    std::thread::yield_now();
-                } else {
-                    block(listener);
-                }
-            }
+            WaitStrategy::Adaptive => self.adapt(listener),
         }
         // Checking the clock costs ~20 ns; spinning checks it every 64 polls.
         (self.strategy != WaitStrategy::Spin || self.polls % 64 == 0) && Instant::now() > deadline
+    }
+
+    /// One adaptive wait: yield while the core is ours and the wait is short,
+    /// else block.
+    fn adapt<S: Service>(&mut self, listener: &Listener<S>) {
+        let now = Instant::now();
+        if let Some(until) = self.contended_until {
+            if now < until {
+                return block(listener);
+            }
+            self.contended_until = None;
+        }
+        if now.duration_since(self.began) > YIELD_WINDOW {
+            return block(listener);
+        }
+        std::thread::yield_now();
+        if now.elapsed() > STOLEN {
+            self.stolen += 1;
+            self.contended_until = Some(Instant::now() + CONTENDED_HOLD);
+        }
     }
 }
 
 fn block<S: Service>(listener: &Listener<S>) {
     let _ = listener.timed_wait(|_| {}, BLOCK_SLICE);
 }
+
+/// What a publisher does while a receiver's buffer is full: sleep briefly
+/// rather than yield, so that a sender far ahead (the leader, which has no
+/// inputs) leaves the core to the nodes it waits for — a yield would hand it
+/// to any competitor for a whole time slice and keep the sender runnable.
+pub fn backpressure_pause() {
+    std::thread::sleep(BACKPRESSURE_SLEEP);
+}
+
+/// The pause of [`backpressure_pause`].
+pub const BACKPRESSURE_SLEEP: Duration = Duration::from_micros(50);

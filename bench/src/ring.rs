@@ -172,7 +172,7 @@ fn touch(path: &Path) -> Result<()> {
     std::fs::write(path, b"").map_err(BenchError::io(path))
 }
 
-/// The runtime's backpressure handler: yield and retry until `timeout`, then fail the send.
+/// The runtime's backpressure handler: pause and retry until `timeout`, then fail the send.
 fn retry_until(
     timeout: Duration,
 ) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send + 'static {
@@ -180,7 +180,7 @@ fn retry_until(
         if info.elapsed_time > timeout {
             BackpressureAction::DiscardDataAndFail
         } else {
-            std::thread::yield_now();
+            attsync_agent::wait::backpressure_pause();
             BackpressureAction::Retry
         }
     }

@@ -170,7 +170,7 @@ impl<S: Service> Ports<S> {
     }
 }
 
-/// A backpressure handler: yield and retry until `timeout`, then give up on
+/// A backpressure handler: pause ([`crate::wait::backpressure_pause`]) and retry until `timeout`, then give up on
 /// that receiver and fail the send (so nothing hangs).
 fn retry_until(
     timeout: Duration,
@@ -180,7 +180,7 @@ fn retry_until(
         if info.elapsed_time > timeout {
             iceoryx2::port::BackpressureAction::DiscardDataAndFail
         } else {
-            std::thread::yield_now();
+            crate::wait::backpressure_pause();
             iceoryx2::port::BackpressureAction::Retry
         }
     }
