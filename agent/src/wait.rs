@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 /// Longest an adaptive waiter yields in one wait before it blocks.
 pub const YIELD_WINDOW: Duration = Duration::from_micros(500);
 /// A yield that takes longer than this lost the core to another program.
-pub const STOLEN: Duration = Duration::from_millis(1);
+pub const STOLEN: Duration = Duration::from_micros(250);
 /// How long an adaptive waiter blocks at once after a stolen yield.
 pub const CONTENDED_HOLD: Duration = Duration::from_secs(1);
 /// Longest single sleep on the wake event.

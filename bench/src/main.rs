@@ -87,6 +87,8 @@ enum Cmd {
         #[arg(long, default_value_t = 20)]
         idle_wait: u64,
     },
+    /// (internal) A CPU-bound competitor of the contention case: spins until killed.
+    Burn,
     /// (internal) One process of the bare iceoryx2 lockstep ring.
     RingNode {
         /// Run id (iceoryx2 namespace).
@@ -171,6 +173,7 @@ fn main() -> ExitCode {
 
 fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
     match cmd {
+        Cmd::Burn => suite::burn(),
         Cmd::RingNode {
             run,
             root,

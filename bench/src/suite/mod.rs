@@ -9,17 +9,23 @@
 //! wait strategy and the same number of steps; and, with the default
 //! strategy (adaptive), two diagnostics that split attsync's per-exchange
 //! cost: a bare lockstep over the scenario's own graph, and attsync with
-//! telemetry reduced to the first and last step.
+//! telemetry reduced to the first and last step. Then the contention case
+//! ([`contend`]): paper-timevarying with as many CPU-bound competitors as
+//! cores, per strategy, against the idle run and the bare ring under load.
 //!
 //! # Layout
 //! - [`plan`]: durations, the cases, the spin rule.
 //! - [`run`](mod@run): running the measurements and aggregating repetitions.
+//! - [`contend`]: the contention case and its competitors.
 //! - [`report`]: the Markdown report.
 //! - this file: [`Options`] and the driver [`run()`].
 
+mod contend;
 mod plan;
 mod report;
 mod run;
+
+pub use contend::burn;
 
 use crate::error::{BenchError, Result};
 use crate::measure::Bins;
@@ -27,6 +33,9 @@ use msgs::config::WaitStrategy;
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::{Duration, Instant};
+
+/// The case measured under contention too (8 nodes, scheme 1).
+const CONTENDED_CASE: &str = "paper-timevarying";
 
 /// Options of `attsync-bench run`.
 #[derive(Debug, Clone)]
@@ -76,6 +85,9 @@ pub fn run(o: &Options) -> Result<String> {
     let mut r = run::Runner::new(o, t0);
     for ci in 0..res.cases.len() {
         r.case(&mut res, ci, &plan, &waits);
+    }
+    if let Some(ci) = res.cases.iter().position(|c| c.label == CONTENDED_CASE) {
+        r.contended(o, &mut res, ci, &plan, &waits);
     }
     let cx = report::Context {
         cores,

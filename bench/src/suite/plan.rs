@@ -22,6 +22,8 @@ pub(super) struct Plan {
     pub spin_steps: u64,
     /// No spin runs above this many processes.
     pub spin_max_nodes: u32,
+    /// Steps of the contention case (adaptive, block; a tenth for yield, spin).
+    pub contend_steps: u64,
 }
 
 impl Plan {
@@ -39,6 +41,7 @@ impl Plan {
             tree100: d(tree100),
             spin_steps,
             spin_max_nodes: 16,
+            contend_steps: if o.quick { 1000 } else { 4000 },
         }
     }
 

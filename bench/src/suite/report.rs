@@ -58,6 +58,7 @@ pub(super) fn report(o: &Options, plan: &Plan, res: &Results, cx: &Context) -> S
     procs(&mut s, res, &mut notes);
     ring(&mut s, res, &mut notes);
     diagnostics(&mut s, res, &mut notes);
+    contended(&mut s, res, cx, &mut notes);
     notes.extend(res.skipped.iter().cloned());
     if !notes.is_empty() {
         let _ = writeln!(s, "\nNotes:");
@@ -281,5 +282,73 @@ fn diagnostics(w: &mut String, res: &Results, notes: &mut Vec<String>) {
         "\n\"bare, scenario's graph\": `ring-node` processes wired like the scenario (each node's inputs and receivers as \
          the process engine wires them, the leader with no inputs), no model. \"telemetry off\": \
          `--set output.sample_period=<duration>` (telemetry only at the first and last step)."
+    );
+}
+
+fn contended(w: &mut String, res: &Results, cx: &Context, notes: &mut Vec<String>) {
+    if res.contended.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        w,
+        "\n### Under contention: {} CPU-bound competitors (`attsync-bench burn`) beside the run\n",
+        cx.cores
+    );
+    let _ = writeln!(
+        w,
+        "| case | nodes | wait | steps | idle wall s | loaded wall s | loaded ÷ idle (wall) | idle lockstep s | loaded lockstep s | loaded ÷ idle (lockstep) | ring idle s | ring loaded s | ring loaded ÷ idle | attsync ÷ ring, loaded (steps/s, lockstep) |"
+    );
+    let _ = writeln!(
+        w,
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for r in &res.contended {
+        let c = &res.cases[r.case];
+        let div = |a: Option<f64>, b: Option<f64>| a.zip(b).map(|(a, b)| a / b);
+        let _ = writeln!(
+            w,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            c.label,
+            c.nodes,
+            wait_name(r.wait),
+            r.steps,
+            f(r.idle.wall, 2),
+            f(r.loaded.wall, 2),
+            f(div(r.loaded.wall, r.idle.wall), 2),
+            f(r.idle.lockstep, 2),
+            f(r.loaded.lockstep, 2),
+            f(div(r.loaded.lockstep, r.idle.lockstep), 2),
+            f(r.ring_idle.span, 2),
+            f(r.ring_loaded.span, 2),
+            f(div(r.ring_loaded.span, r.ring_idle.span), 2),
+            f(div(r.ring_loaded.span, r.loaded.lockstep), 2)
+        );
+        let label = format!("{} contended {}", c.label, wait_name(r.wait));
+        failures(&format!("{label} idle"), &r.idle.errors, r.idle.ok, notes);
+        failures(
+            &format!("{label} loaded"),
+            &r.loaded.errors,
+            r.loaded.ok,
+            notes,
+        );
+        failures(
+            &format!("{label} ring idle"),
+            &r.ring_idle.errors,
+            r.ring_idle.ok,
+            notes,
+        );
+        failures(
+            &format!("{label} ring loaded"),
+            &r.ring_loaded.errors,
+            r.ring_loaded.ok,
+            notes,
+        );
+    }
+    let _ = writeln!(
+        w,
+        "\nEach strategy is measured idle and loaded at the same number of steps (yield and spin at a tenth: \
+         each of their polls can hand a whole time slice to a competitor); \"loaded ÷ idle\" is the slow-down the \
+         competitors cause (the fair share of 2 cores shared with {} CPU-bound programs is about 2×).",
+        cx.cores
     );
 }

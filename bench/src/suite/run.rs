@@ -40,6 +40,19 @@ pub(super) struct Agg {
 }
 
 impl Agg {
+    /// The repetitions' medians, failures kept as errors.
+    pub(super) fn collect(runs: Vec<Result<(AttsyncRun, Option<f64>)>>) -> Self {
+        let mut ok = Vec::new();
+        let mut errors = Vec::new();
+        for r in runs {
+            match r {
+                Ok(x) => ok.push(x),
+                Err(e) => errors.push(e.to_string()),
+            }
+        }
+        Self::of(&ok, errors)
+    }
+
     fn of(runs: &[(AttsyncRun, Option<f64>)], errors: Vec<String>) -> Self {
         let col = |f: &dyn Fn(&AttsyncRun) -> Option<f64>| {
             median(&runs.iter().filter_map(|(r, _)| f(r)).collect::<Vec<_>>())
@@ -73,7 +86,7 @@ pub(super) struct BareAgg {
 }
 
 impl BareAgg {
-    fn push(&mut self, r: Result<(BareRun, Option<f64>)>, spans: &mut Vec<f64>) {
+    pub(super) fn push(&mut self, r: Result<(BareRun, Option<f64>)>, spans: &mut Vec<f64>) {
         match r {
             Ok((b, bg)) => {
                 self.ok += 1;
@@ -115,6 +128,7 @@ pub(super) struct Results {
     pub bare: HashMap<BareSpec, BareAgg>,
     pub bare_order: Vec<BareSpec>,
     pub diag: Vec<DiagRow>,
+    pub contended: Vec<super::contend::ContendRow>,
     pub skipped: Vec<String>,
 }
 
@@ -155,8 +169,21 @@ impl<'a> Runner<'a> {
         eprintln!("[{:6.1} s] {msg}", self.t0.elapsed().as_secs_f64());
     }
 
-    /// One `attsync run` of `case` and the background load during it.
-    fn attsync(
+    /// One `attsync run` of `case` on an idle machine (bounded wait) and the
+    /// background load during it.
+    pub(super) fn attsync(
+        &mut self,
+        case: &Case,
+        engine: Engine,
+        sets: &[String],
+        what: &str,
+    ) -> Result<(AttsyncRun, Option<f64>)> {
+        self.settle();
+        self.attsync_now(case, engine, sets, what)
+    }
+
+    /// [`Runner::attsync`] without waiting for an idle machine.
+    pub(super) fn attsync_now(
         &mut self,
         case: &Case,
         engine: Engine,
@@ -164,7 +191,6 @@ impl<'a> Runner<'a> {
         what: &str,
     ) -> Result<(AttsyncRun, Option<f64>)> {
         self.count += 1;
-        self.settle();
         let out = self.o.work.join("runs").join(format!("{:04}", self.count));
         let meter = CpuMeter::start();
         let r = measure::attsync(
@@ -222,7 +248,27 @@ impl<'a> Runner<'a> {
         if !res.bare.contains_key(spec) {
             res.bare_order.push(spec.clone());
         }
+        let r = self.bare_once(spec, what);
+        let spans = self.bare_spans.entry(spec.clone()).or_default();
+        res.bare.entry(spec.clone()).or_default().push(r, spans);
+    }
+
+    /// One bare lockstep on an idle machine (bounded wait).
+    pub(super) fn bare_once(
+        &mut self,
+        spec: &BareSpec,
+        what: &str,
+    ) -> Result<(BareRun, Option<f64>)> {
         self.settle();
+        self.bare_now(spec, what)
+    }
+
+    /// [`Runner::bare_once`] without waiting for an idle machine.
+    pub(super) fn bare_now(
+        &mut self,
+        spec: &BareSpec,
+        what: &str,
+    ) -> Result<(BareRun, Option<f64>)> {
         let meter = CpuMeter::start();
         let r = bare::bare(&self.o.bins, &self.o.work, spec, RUN_TIMEOUT);
         let bg = meter.foreign_cores();
@@ -236,11 +282,7 @@ impl<'a> Runner<'a> {
             )),
             Err(e) => self.log(&format!("{what} N={}: FAILED: {e}", spec.n)),
         }
-        let spans = self.bare_spans.entry(spec.clone()).or_default();
-        res.bare
-            .entry(spec.clone())
-            .or_default()
-            .push(r.map(|b| (b, bg)), spans);
+        r.map(|b| (b, bg))
     }
 
     /// Runs a bare lockstep until it has `rep + 1` attempts (cached across cases).
