@@ -38,6 +38,8 @@ pub struct Waiter {
     contended_until: Option<Instant>,
     /// Times a yield was stolen (adaptive), for the node's report.
     stolen: u64,
+    /// Longest single sleep on the wake event ([`BLOCK_SLICE`]).
+    slice: Duration,
 }
 
 impl Waiter {
@@ -50,7 +52,17 @@ impl Waiter {
             began: Instant::now(),
             contended_until: None,
             stolen: 0,
+            slice: BLOCK_SLICE,
         }
+    }
+
+    /// The same with another longest sleep on the wake event (for the
+    /// benchmark's test of whether wake-ups are lost: with a long slice a lost
+    /// one shows as a stall).
+    #[must_use]
+    pub fn with_block_slice(mut self, slice: Duration) -> Self {
+        self.slice = slice;
+        self
     }
 
     /// Starts a new wait episode (a new stage's inputs).
@@ -86,7 +98,7 @@ impl Waiter {
         match self.strategy {
             WaitStrategy::Spin => std::hint::spin_loop(),
             WaitStrategy::Yield => std::thread::yield_now(),
-            WaitStrategy::Block => block(listener),
+            WaitStrategy::Block => block(listener, self.slice),
             WaitStrategy::Adaptive => self.adapt(listener),
         }
         // Checking the clock costs ~20 ns; spinning checks it every 64 polls.
@@ -97,25 +109,49 @@ impl Waiter {
     /// else block.
     fn adapt<S: Service>(&mut self, listener: &Listener<S>) {
         let now = Instant::now();
+        match self.adaptive_step(now) {
+            Step::Block => block(listener, self.slice),
+            Step::Yield => {
+                std::thread::yield_now();
+                self.after_yield(now, Instant::now());
+            }
+        }
+    }
+
+    /// What an adaptive wait does at `now`.
+    fn adaptive_step(&mut self, now: Instant) -> Step {
         if let Some(until) = self.contended_until {
             if now < until {
-                return block(listener);
+                return Step::Block;
             }
             self.contended_until = None;
         }
         if now.duration_since(self.began) > YIELD_WINDOW {
-            return block(listener);
+            Step::Block
+        } else {
+            Step::Yield
         }
-        std::thread::yield_now();
-        if now.elapsed() > STOLEN {
+    }
+
+    /// Records a yield from `before` to `after`: if it took longer than
+    /// [`STOLEN`], block at once for [`CONTENDED_HOLD`].
+    fn after_yield(&mut self, before: Instant, after: Instant) {
+        if after.duration_since(before) > STOLEN {
             self.stolen += 1;
-            self.contended_until = Some(Instant::now() + CONTENDED_HOLD);
+            self.contended_until = Some(after + CONTENDED_HOLD);
         }
     }
 }
 
-fn block<S: Service>(listener: &Listener<S>) {
-    let _ = listener.timed_wait(|_| {}, BLOCK_SLICE);
+/// What one adaptive wait does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Step {
+    Yield,
+    Block,
+}
+
+fn block<S: Service>(listener: &Listener<S>, slice: Duration) {
+    let _ = listener.timed_wait(|_| {}, slice);
 }
 
 /// What a publisher does while a receiver's buffer is full: sleep briefly
@@ -128,3 +164,43 @@ pub fn backpressure_pause() {
 
 /// The pause of [`backpressure_pause`].
 pub const BACKPRESSURE_SLEEP: Duration = Duration::from_micros(50);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn adaptive(at: Instant) -> Waiter {
+        let mut w = Waiter::new(WaitStrategy::Adaptive);
+        w.began = at;
+        w
+    }
+
+    #[test]
+    fn adaptive_yields_within_its_window_then_blocks() {
+        let t0 = Instant::now();
+        let mut w = adaptive(t0);
+        assert_eq!(w.adaptive_step(t0), Step::Yield);
+        assert_eq!(w.adaptive_step(t0 + YIELD_WINDOW / 2), Step::Yield);
+        assert_eq!(w.adaptive_step(t0 + YIELD_WINDOW * 2), Step::Block);
+    }
+
+    #[test]
+    fn a_stolen_yield_makes_it_block_for_the_hold_then_yield_again() {
+        let t0 = Instant::now();
+        let mut w = adaptive(t0);
+        // A quick yield (another node ran for a few µs) changes nothing.
+        w.after_yield(t0, t0 + Duration::from_micros(20));
+        assert_eq!((w.stolen(), w.adaptive_step(t0)), (0, Step::Yield));
+        // A competitor kept the core for a time slice.
+        let back = t0 + Duration::from_millis(3);
+        w.after_yield(t0, back);
+        assert_eq!(w.stolen(), 1);
+        w.began = back;
+        assert_eq!(w.adaptive_step(back), Step::Block);
+        assert_eq!(w.adaptive_step(back + CONTENDED_HOLD / 2), Step::Block);
+        // After the hold a new episode yields again (a probe).
+        let later = back + CONTENDED_HOLD + Duration::from_millis(1);
+        w.began = later;
+        assert_eq!(w.adaptive_step(later), Step::Yield);
+    }
+}

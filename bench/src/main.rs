@@ -124,6 +124,9 @@ enum Cmd {
         /// Longest wait at each barrier, s.
         #[arg(long, default_value_t = 120.0)]
         barrier_timeout: f64,
+        /// Longest single sleep on the wake event, ms (a lost wake-up costs this).
+        #[arg(long, default_value_t = 1)]
+        block_slice_ms: u64,
     },
 }
 
@@ -186,6 +189,7 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             max_fanout,
             stage_timeout,
             barrier_timeout,
+            block_slice_ms,
         } => {
             let node = ring::RingNode {
                 run,
@@ -199,6 +203,7 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
                 max_fanout,
                 stage_timeout,
                 barrier_timeout,
+                block_slice: std::time::Duration::from_millis(block_slice_ms),
             };
             println!("{}", node.run()?.line());
             Ok(())

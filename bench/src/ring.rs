@@ -69,6 +69,8 @@ pub struct RingNode {
     pub stage_timeout: f64,
     /// Longest wait for each barrier, s.
     pub barrier_timeout: f64,
+    /// Longest single sleep on the wake event (default the runtime's 1 ms).
+    pub block_slice: Duration,
 }
 
 /// What a ring node measured.
@@ -378,7 +380,7 @@ impl RingNode {
     fn lockstep(&self, p: &Ports, inputs: &[u32]) -> Result<()> {
         let id = self.index;
         let stage_timeout = Duration::from_secs_f64(self.stage_timeout);
-        let mut waiter = Waiter::new(self.wait);
+        let mut waiter = Waiter::new(self.wait).with_block_slice(self.block_slice);
         let notify = waiter.receivers_may_block();
         for n in 0..self.steps {
             for s in 0..4u32 {

@@ -20,7 +20,8 @@ pub enum WaitStrategy {
     Yield,
     /// Sleep on the node's wake event (1 ms slices; re-poll after every wake).
     Block,
-    /// Yield for a short while, then block.
+    /// Yield for a short while (≤ 0.5 ms), then block; block at once while
+    /// yields show that another program takes the core.
     Adaptive,
 }
 

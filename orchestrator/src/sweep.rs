@@ -14,7 +14,7 @@ use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
 use crate::results::layout::SweepLayout;
 use crate::results::staging::Staging;
-use crate::run::{RunError, RunOptions, run};
+use crate::run::{Engine, RunError, RunOptions, run};
 use crate::scenario::{self, Loaded, ScenarioError};
 use plotters::prelude::*;
 use std::fmt::Write as _;
@@ -166,10 +166,37 @@ pub fn default_quantum(param: &str, dt: f64) -> Option<f64> {
     timing.then_some(dt)
 }
 
-/// The default number of runs at once: the number of cores (2 if unknown).
+/// The number of cores (2 if unknown).
 #[must_use]
-pub fn default_jobs() -> usize {
+pub fn cores() -> usize {
     std::thread::available_parallelism().map_or(2, std::num::NonZero::get)
+}
+
+/// The default number of runs at once, so that a sweep does not by itself
+/// oversubscribe the machine: with the in-process engine one run per core;
+/// with the process engine (a run is `nodes` processes in lockstep) as many
+/// runs as fit `cores` processes, at least one.
+#[must_use]
+pub fn default_jobs(engine: Engine, nodes: usize, cores: usize) -> usize {
+    match engine {
+        Engine::InProcess => cores.max(1),
+        Engine::Processes => (cores / nodes.max(1)).max(1),
+    }
+}
+
+/// A warning when `jobs` runs of `nodes` processes each put more lockstep
+/// processes on the machine than one run alone (a run slows down by more
+/// than its share: a late node stalls its whole network).
+#[must_use]
+pub fn oversubscription(engine: Engine, jobs: usize, nodes: usize, cores: usize) -> Option<String> {
+    let fits = default_jobs(engine, nodes, cores);
+    (engine == Engine::Processes && jobs > fits).then(|| {
+        format!(
+            "--jobs {jobs}: {jobs} runs of {nodes} processes each is {} lockstep processes on {cores} cores; \
+             each run then waits for its slowest node's turn on a core (the default, --jobs {fits}, avoids this)",
+            jobs * nodes
+        )
+    })
 }
 
 /// One run of a sweep.
@@ -503,7 +530,20 @@ fn plot(file: &Path, param: &str, rows: &[SweepRow]) -> Result<(), String> {
 mod tests {
     use super::*;
     use crate::processes::ProcessOptions;
-    use crate::run::Engine;
+
+    #[test]
+    fn a_sweep_does_not_oversubscribe_the_machine_by_default() {
+        // The paper run: 8 processes; 2 cores: one run at a time.
+        assert_eq!(default_jobs(Engine::Processes, 8, 2), 1);
+        assert_eq!(default_jobs(Engine::Processes, 8, 16), 2);
+        assert_eq!(default_jobs(Engine::Processes, 3, 16), 5);
+        assert_eq!(default_jobs(Engine::InProcess, 8, 2), 2);
+        assert_eq!(oversubscription(Engine::Processes, 1, 8, 2), None);
+        let w = oversubscription(Engine::Processes, 2, 8, 2).unwrap();
+        assert!(w.contains("16 lockstep processes on 2 cores"), "{w}");
+        assert!(w.contains("--jobs 1"), "{w}");
+        assert_eq!(oversubscription(Engine::InProcess, 4, 8, 2), None);
+    }
 
     fn paper() -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/constant-observerless.toml")

@@ -115,7 +115,7 @@ pub enum WaitArg {
     Yield,
     /// Sleep on iceoryx2 events (1 ms slices).
     Block,
-    /// Yield a while, then block.
+    /// Yield a while (≤ 0.5 ms), then block; block at once on a busy machine.
     Adaptive,
 }
 

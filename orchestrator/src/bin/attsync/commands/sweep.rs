@@ -19,7 +19,7 @@ pub struct Sweep {
     /// Values, comma-separated (TOML literals).
     #[arg(long, value_delimiter = ',', required = true)]
     pub values: Vec<String>,
-    /// Runs at once [default: number of cores].
+    /// Runs at once [default: in-process, the number of cores; processes, as many runs as fit the cores (nodes × runs ≤ cores), at least 1].
     #[arg(long)]
     pub jobs: Option<usize>,
     #[command(flatten)]
@@ -47,7 +47,7 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
         scenario: a.scenario.scenario.clone(),
         param: a.param,
         values: a.values,
-        jobs: a.jobs.unwrap_or_else(sweep::default_jobs),
+        jobs: a.jobs.unwrap_or(1),
         set: a.scenario.overrides.set.clone(),
         run: RunOptions {
             engine: a.engine.engine,
@@ -63,6 +63,16 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
     };
     o.validate()?;
     let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values)?;
+    let nodes = base.resolved.network.agents.len() + 1;
+    let cores = sweep::cores();
+    match a.jobs {
+        None => o.jobs = sweep::default_jobs(o.run.engine, nodes, cores),
+        Some(jobs) => {
+            if let Some(w) = sweep::oversubscription(o.run.engine, jobs, nodes, cores) {
+                eprintln!("warning: {w}");
+            }
+        }
+    }
     if a.out.is_none() {
         o.run.out = sweep::default_out(&base, &o.param);
     }
