@@ -411,6 +411,16 @@ impl RingNode {
                             });
                         }
                     };
+                    let waited = stage_timeout.saturating_sub(deadline - Instant::now());
+                    if waited >= self.block_slice && self.block_slice >= Duration::from_millis(100) {
+                        // With a long slice, a wait that long means no wake-up came.
+                        eprintln!(
+                            "ring-node {id}: step {n} stage {s}: waited {:.3} s for node {} (block slice {:.3} s)",
+                            waited.as_secs_f64(),
+                            inputs[k],
+                            self.block_slice.as_secs_f64()
+                        );
+                    }
                     if msg.version != PROTOCOL_VERSION
                         || msg.sender != inputs[k]
                         || (msg.step, msg.stage) != (n, s)

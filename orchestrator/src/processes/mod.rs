@@ -18,13 +18,17 @@
 //! - `blame`: which node made the run fail, and why.
 //! - `shutdown`: `Stop` and the exits, or killing every node.
 //! - [`supervise`]: the node processes (tokio): spawn, exits, kill.
+//! - [`placement`]: spread the nodes over the cores, or pack them onto one
+//!   while the machine is busy (`load`: the CPU load it decides on).
 //! - [`namespace`]: a run's iceoryx2 namespace on this machine.
 
 mod blame;
 mod collect;
 mod configs;
+mod load;
 pub mod namespace;
 pub mod node_log;
+pub mod placement;
 pub mod ports;
 pub mod reaper;
 mod shutdown;
@@ -60,6 +64,8 @@ pub struct ProcessOptions {
     pub realtime: Option<f64>,
     /// Agents run by the user's own programs.
     pub plugins: Vec<Plugin>,
+    /// Where the node processes run ([`placement::Placement`]).
+    pub placement: placement::Placement,
 }
 
 impl Default for ProcessOptions {
@@ -70,6 +76,7 @@ impl Default for ProcessOptions {
             start_timeout: 30.0,
             realtime: None,
             plugins: Vec::new(),
+            placement: placement::Placement::Auto,
         }
     }
 }
@@ -139,6 +146,7 @@ pub fn run(
         "processes: ports open, spawning"
     );
     s.spawn_nodes()?;
+    let placer = placement::Placer::start(opts.placement, s.sup.pids().to_vec());
     tracing::debug!("processes: spawned, waiting for Ready");
     let failure = s
         .await_ready()
@@ -149,6 +157,7 @@ pub fn run(
         .and_then(|()| s.collect(&mut on_sample))
         .err()
         .map(|f| s.blame(f));
+    drop(placer);
     tracing::debug!(failure = ?failure, "processes: stepping over, shutting down");
     let failure = s.shutdown(failure);
     tracing::debug!("processes: shut down, namespace removed");

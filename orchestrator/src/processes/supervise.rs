@@ -60,6 +60,8 @@ pub struct Supervisor {
     ended: usize,
     /// Leave a node's process group alone when the node exits.
     keep_groups: bool,
+    /// Process ids of the nodes started.
+    pids: Vec<u32>,
 }
 
 impl Supervisor {
@@ -79,7 +81,14 @@ impl Supervisor {
             started: 0,
             ended: 0,
             keep_groups: false,
+            pids: Vec::new(),
         })
+    }
+
+    /// Process ids of the nodes started so far.
+    #[must_use]
+    pub fn pids(&self) -> &[u32] {
+        &self.pids
     }
 
     /// Leaves the process group of a node that exits by itself alone (by
@@ -122,6 +131,7 @@ impl Supervisor {
         let _guard = self.rt.enter();
         let spawned = cmd.spawn();
         let pid = spawned.as_ref().ok().and_then(tokio::process::Child::id);
+        self.pids.extend(pid);
         let keep_groups = self.keep_groups;
         self.rt.spawn(async move {
             let (mut child, copy) = match spawned {

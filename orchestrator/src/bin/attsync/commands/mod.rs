@@ -11,6 +11,7 @@ mod sweep;
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::processes::ProcessOptions;
+use attsync::processes::placement::Placement;
 use attsync::run::Engine;
 use attsync::scenario::{self, Loaded};
 use clap::{Subcommand, ValueEnum};
@@ -92,6 +93,9 @@ pub struct EngineArgs {
     /// Longest wait of a node for one stage's inputs, s (processes engine).
     #[arg(long, default_value_t = 10.0)]
     pub stage_timeout: f64,
+    /// Where node processes run (processes engine): auto = spread over the cores, packed onto one while other programs keep the machine busy.
+    #[arg(long, value_enum, default_value_t = Placement::Auto)]
+    pub placement: Placement,
 }
 
 impl EngineArgs {
@@ -101,6 +105,7 @@ impl EngineArgs {
             wait: self.wait.into(),
             stage_timeout: self.stage_timeout,
             realtime,
+            placement: self.placement,
             ..ProcessOptions::default()
         }
     }

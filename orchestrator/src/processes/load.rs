@@ -1,0 +1,125 @@
+//! The machine's CPU load as [`super::placement`] needs it: busy time per
+//! core (`/proc/stat`) and the CPU time of the run's own processes
+//! (`/proc/<pid>/stat`), in clock ticks, turned into a
+//! [`Window`] per sampling period.
+
+use super::placement::{
+    FIRST_WINDOW, HYSTERESIS, Placed, Placement, State, WINDOW, Window, decide, least_busy, place,
+};
+use nix::sched::CpuSet;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Busy and total ticks of each core, by core number.
+fn per_core_ticks() -> Vec<(usize, u64, u64)> {
+    let Ok(stat) = std::fs::read_to_string("/proc/stat") else {
+        return Vec::new();
+    };
+    stat.lines()
+        .filter_map(|l| {
+            let rest = l.strip_prefix("cpu")?;
+            let (num, fields) = rest.split_once(' ')?;
+            let core = num.parse().ok()?;
+            let v: Vec<u64> = fields.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+            // user nice system idle iowait irq softirq steal …
+            let total: u64 = v.iter().take(8).sum();
+            let idle = v.get(3).copied().unwrap_or(0) + v.get(4).copied().unwrap_or(0);
+            Some((core, total - idle, total))
+        })
+        .collect()
+}
+
+/// utime + stime of `pid` (all its threads), ticks.
+fn process_ticks(pid: &str) -> u64 {
+    let Ok(s) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
+        return 0;
+    };
+    // Fields after the command name (which may hold spaces and parentheses).
+    let Some((_, rest)) = s.rsplit_once(')') else {
+        return 0;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    // rest[0] is field 3 (state); utime, stime are fields 14, 15.
+    let at = |i: usize| f.get(i - 3).and_then(|x| x.parse::<u64>().ok()).unwrap_or(0);
+    at(14) + at(15)
+}
+
+/// One sample: per-core (busy, total) and the run's own ticks.
+struct Sample {
+    cores: Vec<(usize, u64, u64)>,
+    own: u64,
+}
+
+fn sample(pids: &[u32], allowed: &[usize]) -> Sample {
+    let cores = per_core_ticks()
+        .into_iter()
+        .filter(|(c, _, _)| allowed.contains(c))
+        .collect();
+    let own = pids.iter().map(|p| process_ticks(&p.to_string())).sum::<u64>()
+        + process_ticks("self");
+    Sample { cores, own }
+}
+
+/// The window between two samples.
+fn window(a: &Sample, b: &Sample) -> Window {
+    let mut busy = 0u64;
+    let mut span = 0u64;
+    let mut per_core = Vec::new();
+    for (&(core, b0, t0), &(_, b1, t1)) in a.cores.iter().zip(&b.cores) {
+        let (db, dt) = (b1.saturating_sub(b0), t1.saturating_sub(t0));
+        busy += db;
+        span = span.max(dt);
+        per_core.push((core, if dt == 0 { 0.0 } else { db as f64 / dt as f64 }));
+    }
+    let foreign = busy.saturating_sub(b.own.saturating_sub(a.own));
+    Window {
+        foreign: if span == 0 { 0.0 } else { foreign as f64 / span as f64 },
+        per_core,
+    }
+}
+
+/// Samples every [`WINDOW`] until `stop`, placing `pids` per `placement`.
+pub(super) fn watch(
+    placement: Placement,
+    pids: &[u32],
+    allowed: &CpuSet,
+    cores: &[usize],
+    stop: &AtomicBool,
+) {
+    // The first decision takes one short window: a run should not spend
+    // its first half second spread over a busy machine.
+    let mut state = State {
+        placed: Placed::Spread,
+        streak: HYSTERESIS - 1,
+    };
+    let mut last = sample(pids, cores);
+    let mut period = FIRST_WINDOW;
+    while !stop.load(Ordering::Relaxed) {
+        std::thread::sleep(period);
+        period = WINDOW;
+        let now = sample(pids, cores);
+        let w = window(&last, &now);
+        last = now;
+        let next = match placement {
+            Placement::Auto => decide(state, &w),
+            Placement::Pack if state.placed == Placed::Spread => State {
+                placed: least_busy(&w).map_or(Placed::Spread, Placed::Packed),
+                streak: 0,
+            },
+            Placement::Pack | Placement::Spread => state,
+        };
+        if next.placed != state.placed {
+            tracing::info!(
+                foreign_cores = w.foreign,
+                placement = ?next.placed,
+                "placement: other programs use {:.1} cores; nodes {}",
+                w.foreign,
+                match next.placed {
+                    Placed::Spread => "spread over every core".to_string(),
+                    Placed::Packed(c) => format!("packed onto core {c}"),
+                }
+            );
+            place(pids, next.placed, allowed);
+        }
+        state = next;
+    }
+}
