@@ -412,7 +412,8 @@ impl RingNode {
                         }
                     };
                     let waited = stage_timeout.saturating_sub(deadline - Instant::now());
-                    if waited >= self.block_slice && self.block_slice >= Duration::from_millis(100) {
+                    if waited >= self.block_slice && self.block_slice >= Duration::from_millis(100)
+                    {
                         // With a long slice, a wait that long means no wake-up came.
                         eprintln!(
                             "ring-node {id}: step {n} stage {s}: waited {:.3} s for node {} (block slice {:.3} s)",

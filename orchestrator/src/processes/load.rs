@@ -19,7 +19,10 @@ fn per_core_ticks() -> Vec<(usize, u64, u64)> {
             let rest = l.strip_prefix("cpu")?;
             let (num, fields) = rest.split_once(' ')?;
             let core = num.parse().ok()?;
-            let v: Vec<u64> = fields.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+            let v: Vec<u64> = fields
+                .split_whitespace()
+                .filter_map(|x| x.parse().ok())
+                .collect();
             // user nice system idle iowait irq softirq steal …
             let total: u64 = v.iter().take(8).sum();
             let idle = v.get(3).copied().unwrap_or(0) + v.get(4).copied().unwrap_or(0);
@@ -39,7 +42,11 @@ fn process_ticks(pid: &str) -> u64 {
     };
     let f: Vec<&str> = rest.split_whitespace().collect();
     // rest[0] is field 3 (state); utime, stime are fields 14, 15.
-    let at = |i: usize| f.get(i - 3).and_then(|x| x.parse::<u64>().ok()).unwrap_or(0);
+    let at = |i: usize| {
+        f.get(i - 3)
+            .and_then(|x| x.parse::<u64>().ok())
+            .unwrap_or(0)
+    };
     at(14) + at(15)
 }
 
@@ -54,7 +61,10 @@ fn sample(pids: &[u32], allowed: &[usize]) -> Sample {
         .into_iter()
         .filter(|(c, _, _)| allowed.contains(c))
         .collect();
-    let own = pids.iter().map(|p| process_ticks(&p.to_string())).sum::<u64>()
+    let own = pids
+        .iter()
+        .map(|p| process_ticks(&p.to_string()))
+        .sum::<u64>()
         + process_ticks("self");
     Sample { cores, own }
 }
@@ -72,7 +82,11 @@ fn window(a: &Sample, b: &Sample) -> Window {
     }
     let foreign = busy.saturating_sub(b.own.saturating_sub(a.own));
     Window {
-        foreign: if span == 0 { 0.0 } else { foreign as f64 / span as f64 },
+        foreign: if span == 0 {
+            0.0
+        } else {
+            foreign as f64 / span as f64
+        },
         per_core,
     }
 }

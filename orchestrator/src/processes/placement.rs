@@ -118,7 +118,9 @@ fn apply(pid: u32, set: &CpuSet) {
 
 /// The cores of `set`.
 fn cores_of(set: &CpuSet) -> Vec<usize> {
-    (0..CpuSet::count()).filter(|&c| set.is_set(c).unwrap_or(false)).collect()
+    (0..CpuSet::count())
+        .filter(|&c| set.is_set(c).unwrap_or(false))
+        .collect()
 }
 
 /// Samples the load and moves the run's nodes; stops when dropped.
@@ -139,7 +141,9 @@ impl Placer {
         let cores = cores_of(&allowed);
         let flag = Arc::clone(&stop);
         let thread = (cores.len() > 1 && placement != Placement::Spread).then(|| {
-            std::thread::spawn(move || super::load::watch(placement, &pids, &allowed, &cores, &flag))
+            std::thread::spawn(move || {
+                super::load::watch(placement, &pids, &allowed, &cores, &flag)
+            })
         });
         Self { stop, thread }
     }

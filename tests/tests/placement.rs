@@ -1,0 +1,138 @@
+//! `--placement`: where a run's node processes may run. `pack` puts every
+//! node on one core, `spread` leaves them on every core, `auto` (the
+//! default) packs only while other programs keep the machine busy — tested
+//! here with as many CPU-bound competitors as cores. The placement never
+//! changes what a node computes: results are byte-identical.
+//!
+//! The test reads each node's allowed CPUs from `/proc/<pid>/status`
+//! (`Cpus_allowed_list`) while the run steps; every wait is bounded.
+
+use attsync_tests::{
+    Attsync, Sandbox, assert_same_results, node_pid, owned_runs, paper, run_args, wait_until,
+};
+use std::path::Path;
+use std::process::{Child, Command};
+use std::time::Duration;
+
+const POLL: Duration = Duration::from_millis(10);
+
+fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
+}
+
+/// The CPUs node `id` of `run` may run on, as `/proc` lists them ("0-1", "1").
+fn allowed(run: &str, id: u32) -> Option<String> {
+    let pid = node_pid(run, id)?;
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))
+        .map(|s| s.trim().to_string())
+}
+
+/// Runs the paper's scheme-1 scenario for `duration` s with `args`, and
+/// waits (bounded) until `seen(allowed CPUs of agent 1)` holds while it
+/// steps. Returns whether it was seen; the run is waited for and must succeed.
+fn run_and_watch(
+    sb: &Sandbox,
+    out: &str,
+    duration: &str,
+    args: &[&str],
+    seen: impl Fn(&str) -> bool,
+) -> bool {
+    let set = format!("simulation.duration={duration}");
+    let running = Attsync::new(sb.path())
+        .args(run_args(
+            &paper("timevarying"),
+            "processes",
+            &sb.join(out),
+            &[&set],
+        ))
+        .args(args.iter().copied())
+        .spawn();
+    let pid = running.pid();
+    let run = wait_until(Duration::from_secs(30), POLL, || {
+        owned_runs(pid).into_iter().next()
+    })
+    .expect("the run's namespace");
+    let hit = wait_until(Duration::from_secs(60), POLL, || {
+        allowed(&run, 1).filter(|a| seen(a)).map(|_| ())
+    })
+    .is_some();
+    running
+        .wait(attsync_tests::RUN_TIMEOUT)
+        .assert_ok()
+        .assert_no_leftovers();
+    hit
+}
+
+fn single_core(list: &str) -> bool {
+    !list.contains('-') && !list.contains(',')
+}
+
+/// CPU-bound competitors, killed when dropped.
+struct Burners(Vec<Child>);
+
+impl Burners {
+    fn start(k: usize) -> Self {
+        Self(
+            (0..k)
+                .map(|_| {
+                    Command::new("sh")
+                        .args(["-c", "while :; do :; done"])
+                        .spawn()
+                        .expect("sh")
+                })
+                .collect(),
+        )
+    }
+}
+
+impl Drop for Burners {
+    fn drop(&mut self) {
+        for c in &mut self.0 {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+#[test]
+fn pack_puts_every_node_on_one_core_and_changes_no_result() {
+    if cores() < 2 {
+        eprintln!("one core: packing and spreading are the same here");
+        return;
+    }
+    let sb = Sandbox::new("placement-pack");
+    let packed = run_and_watch(&sb, "packed", "20", &["--placement", "pack"], single_core);
+    assert!(
+        packed,
+        "agent 1 never ran on a single core with --placement pack"
+    );
+    let spread = run_and_watch(&sb, "spread", "20", &["--placement", "spread"], |a| {
+        !single_core(a)
+    });
+    assert!(
+        spread,
+        "agent 1 ran on a single core with --placement spread"
+    );
+    assert_same_results(&sb.join("packed"), &sb.join("spread"));
+}
+
+#[test]
+fn auto_packs_while_competitors_keep_every_core_busy() {
+    if cores() < 2 {
+        eprintln!("one core: nothing to pack");
+        return;
+    }
+    let sb = Sandbox::new("placement-auto");
+    let burners = Burners::start(cores());
+    let packed = run_and_watch(&sb, "auto", "10", &[], single_core);
+    drop(burners);
+    assert!(
+        packed,
+        "with {} competitors the nodes were never packed",
+        cores()
+    );
+    assert!(Path::new(&sb.join("auto/errors.csv")).is_file());
+}
