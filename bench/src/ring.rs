@@ -470,6 +470,7 @@ mod tests {
             max_fanout: 2,
             stage_timeout: 1.0,
             barrier_timeout: 1.0,
+            block_slice: Duration::from_millis(1),
         };
         assert_eq!(node.topology().unwrap(), (vec![7, 1], vec![7, 1]));
     }
