@@ -23,7 +23,8 @@
 //! ```
 //!
 //! with `e` an eigenvalue of `E(A)` over the loop's gain matrices and `j` an
-//! eigenvalue of an inertia. The gain matrices, inertias and `M` do not
+//! eigenvalue of an inertia. Every block is block-triangular: its modes are
+//! the roots of `s² + d s + k` and the eigenvalues of `P − k_σ μ I`. The gain matrices, inertias and `M` do not
 //! commute in general, so each is replaced by the interval of its eigenvalues
 //! ([`Interval`]); the blocks are evaluated on a grid over the intervals (ends
 //! included) and their eigenvalues computed numerically. RK4's stability
@@ -31,7 +32,7 @@
 //! ([`rk4_amplification`]), searched along the ray of each eigenvalue
 //! ([`rk4_step_limit`]).
 
-use nalgebra::{Complex, DMatrix, Matrix3};
+use nalgebra::{Complex, Matrix3};
 
 /// A closed interval `[min, max]` holding every eigenvalue of a family of
 /// matrices (the extremes are what a loop's estimate depends on).
@@ -218,7 +219,8 @@ pub fn psi_gain(a: &Matrix3<f64>) -> Matrix3<f64> {
     (Matrix3::identity() * a.trace() - a) * 0.5
 }
 
-/// The eigenvalues of every block of `l` on the grid over its intervals.
+/// The eigenvalues of every block of `l` on the grid over its intervals
+/// (each distinct root once).
 #[must_use]
 pub fn eigenvalues(l: &Loop) -> Vec<Complex<f64>> {
     let mut out = Vec::new();
@@ -266,22 +268,34 @@ pub fn eigenvalues(l: &Loop) -> Vec<Complex<f64>> {
 }
 
 /// Eigenvalues of `[[0, I, 0], [−k I, −d I, I], [0, 0, S]]` (6×6 without
-/// `S`, 9×9 with it): `ẍ + d ẋ + k x = σ`, `σ̇ = S σ`.
+/// `S`, 9×9 with it): `ẍ + d ẋ + k x = σ`, `σ̇ = S σ`. The block is upper
+/// block-triangular, so its spectrum is that of `S` (3×3, computed
+/// numerically) and, three times over, the roots of `s² + d s + k`.
+///
+/// # NOTE
+/// Not `DMatrix::complex_eigenvalues` of the 9×9 block: nalgebra's Schur
+/// iteration has no iteration limit there and does not converge on such
+/// blocks with repeated eigenvalues (it hung on the paper's scenarios).
 fn second_order(k: f64, d: f64, s: Option<&Matrix3<f64>>) -> Vec<Complex<f64>> {
-    let n = if s.is_some() { 9 } else { 6 };
-    let mut m = DMatrix::<f64>::zeros(n, n);
-    for a in 0..3 {
-        m[(a, 3 + a)] = 1.0;
-        m[(3 + a, a)] = -k;
-        m[(3 + a, 3 + a)] = -d;
-    }
+    let mut out = quadratic_roots(d, k).to_vec();
     if let Some(s) = s {
-        for a in 0..3 {
-            m[(3 + a, 6 + a)] = 1.0;
-        }
-        m.view_mut((6, 6), (3, 3)).copy_from(s);
+        out.extend(s.complex_eigenvalues().iter().copied());
     }
-    m.complex_eigenvalues().iter().copied().collect()
+    out
+}
+
+/// The roots of `s² + d s + k` (real roots without cancellation).
+#[must_use]
+pub fn quadratic_roots(d: f64, k: f64) -> [Complex<f64>; 2] {
+    let disc = d * d - 4.0 * k;
+    if disc >= 0.0 {
+        let q = -0.5 * (d + d.signum() * disc.sqrt());
+        let other = if q == 0.0 { 0.0 } else { k / q };
+        [Complex::new(q, 0.0), Complex::new(other, 0.0)]
+    } else {
+        let im = 0.5 * (-disc).sqrt();
+        [Complex::new(-0.5 * d, im), Complex::new(-0.5 * d, -im)]
+    }
 }
 
 /// RK4's amplification factor `|1 + z + z²/2 + z³/6 + z⁴/24|` (one step of
@@ -402,6 +416,16 @@ mod tests {
         // σ̃ modes: eig(P) − 4000 → fastest ≈ 4001.
         assert!((est.loops[0].fastest_rate - 4001.0).abs() < 1e-6, "{est:?}");
         assert!((est.dt_max - 2.785_293_563 / 4001.0).abs() < 1e-8);
+    }
+
+    #[test]
+    fn quadratic_roots_solve_the_quadratic() {
+        for (d, k) in [(10.0, 9.0), (1.0, 100.0), (1e4, 1e-2), (0.0, 4.0)] {
+            for r in quadratic_roots(d, k) {
+                let v = r * r + r * d + Complex::new(k, 0.0);
+                assert!(v.norm() <= 1e-9 * (d * d + k), "{d} {k} {r}");
+            }
+        }
     }
 
     #[test]
