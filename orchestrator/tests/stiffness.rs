@@ -157,3 +157,49 @@ fn just_below_the_bound_stays_finite_well_above_diverges() {
         assert!(!stays_finite(&l.resolved.network), "{file} {set}: finite at 2.5·dt_max");
     }
 }
+
+/// The CLI: `check` refuses the stiff scenario (exit 2) naming the field,
+/// the bound and a step that works; `--no-stiffness-check` lets `check` and
+/// `run` through with a warning (the run then goes on, whatever it does).
+#[test]
+fn cli_refuses_a_stiff_scenario_unless_told_not_to() {
+    let bin = env!("CARGO_BIN_EXE_attsync");
+    let file = paper("timevarying.toml");
+    let set = ["--set", STIFF_SIGMA];
+    let out = std::process::Command::new(bin)
+        .arg("check")
+        .arg(&file)
+        .args(set)
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("simulation.dt: dt = 0.001 s exceeds the largest stable step"), "{err}");
+    assert!(err.contains("try --set simulation.dt=0.00025"), "{err}");
+    let out = std::process::Command::new(bin)
+        .arg("check")
+        .arg(&file)
+        .args(set)
+        .arg("--no-stiffness-check")
+        .output()
+        .expect("runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("largest stable dt 3.268e-4 s for dt = 0.001 s: margin dt_max/dt = 0.327"), "{text}");
+    assert!(text.contains("(not refused: --no-stiffness-check)"), "{text}");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = std::process::Command::new(bin)
+        .arg("run")
+        .arg(&file)
+        .args(set)
+        .args(["--set", "simulation.duration=0.02", "--engine", "in-process", "--quiet"])
+        .arg("--no-stiffness-check")
+        .arg("--out")
+        .arg(dir.path().join("r"))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("warning:") && err.contains("simulation.dt"), "{err}");
+    assert!(dir.path().join("r/errors.csv").exists(), "{err}");
+}
