@@ -432,12 +432,19 @@ mod tests {
     fn psi_gain_of_a_diagonal_matrix() {
         let a = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 2.0, 4.0));
         let e = psi_gain(&a);
-        assert_eq!(e, Matrix3::from_diagonal(&nalgebra::Vector3::new(3.0, 2.5, 1.5)));
+        assert_eq!(
+            e,
+            Matrix3::from_diagonal(&nalgebra::Vector3::new(3.0, 2.5, 1.5))
+        );
     }
 
     #[test]
     fn grid_includes_both_ends() {
-        let g = Interval { min: 0.1, max: 10.0 }.grid(5);
+        let g = Interval {
+            min: 0.1,
+            max: 10.0,
+        }
+        .grid(5);
         assert_eq!(g.len(), 5);
         assert!((g[0] - 0.1).abs() < 1e-15 && (g[4] - 10.0).abs() < 1e-12);
         assert_eq!(Interval::point(3.0).grid(5), vec![3.0]);

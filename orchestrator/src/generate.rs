@@ -3,14 +3,14 @@
 //! (Theorem 1's condition with a margin) and `dt` (RK4's stable step) so that
 //! the scenario validates and stays finite.
 
+use crate::options::StiffnessCheck;
+use crate::scenario::Resolved;
+use crate::scenario::resolve::stable_dt;
 use crate::scenario::schema::{
     AgentSpec, ControlGainsSpec, CouplingKind, EdgeSpec, LeaderLinkSpec, LeaderSpec, MatrixSpec,
     ObserverGainsSpec, ObserverInit, Output, ReferenceKind, RotationSpec, Scenario, SchemeKind,
     SchemeSpec, Simulation,
 };
-use crate::options::StiffnessCheck;
-use crate::scenario::Resolved;
-use crate::scenario::resolve::stable_dt;
 use attitude::checks::{appendix_d_min_eigenvalue, sym_eigenvalues, xi_plus_laplacian};
 use nalgebra::Matrix3;
 use rand::seq::index::sample;

@@ -558,13 +558,21 @@ mod tests {
     fn every_value_is_checked_before_anything_runs() {
         let set = ["simulation.duration=0.1".to_string()];
         let ok = ["0".to_string(), "0.01".to_string()];
-        let base = load_checked(&paper(), &set, "network.delay", &ok, StiffnessCheck::Refuse).expect("valid");
+        let base = load_checked(&paper(), &set, "network.delay", &ok, StiffnessCheck::Refuse)
+            .expect("valid");
         assert_eq!(
             default_out(&base, "agent[2].omega"),
             PathBuf::from(format!("results/{}-sweep-agent_2__omega", base.name()))
         );
         let bad = ["0".to_string(), "-1".to_string()];
-        let e = load_checked(&paper(), &set, "network.delay", &bad, StiffnessCheck::Refuse).unwrap_err();
+        let e = load_checked(
+            &paper(),
+            &set,
+            "network.delay",
+            &bad,
+            StiffnessCheck::Refuse,
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("network.delay"), "{e}");
     }
 

@@ -7,8 +7,8 @@
 
 use attitude::engine::InProcess;
 use attsync::generate::{DT_FRACTION, TreeParams, tree};
-use attsync::scenario::{Loaded, load_str};
 use attsync::scenario::schema::SchemeKind;
+use attsync::scenario::{Loaded, load_str};
 use std::path::Path;
 
 const SCHEMES: [SchemeKind; 3] = [
@@ -29,7 +29,8 @@ fn generate(agents: u32, leader_links: u32, seed: u64, scheme: SchemeKind) -> Lo
     let g = tree(&p).expect("valid parameters");
     let mut text: String = g.notes.iter().map(|n| format!("# {n}\n")).collect();
     text.push_str(&toml::to_string(&g.scenario).expect("serialises"));
-    let steps = "simulation.duration=".to_string() + &(g.scenario.simulation.dt * 300.0).to_string();
+    let steps =
+        "simulation.duration=".to_string() + &(g.scenario.simulation.dt * 300.0).to_string();
     let sample = format!("output.sample_period={}", g.scenario.simulation.dt * 10.0);
     load_str(Path::new("gen.toml"), &text, &[steps, sample])
         .unwrap_or_else(|e| panic!("{agents} agents, seed {seed}, {scheme:?}: {e}"))
@@ -58,9 +59,15 @@ fn check(agents: u32, leader_links: u32, seed: u64, scheme: SchemeKind) {
         l.resolved.warnings
     );
     let est = l.resolved.stiffness.clone().expect("agents");
-    assert!(l.resolved.network.dt <= DT_FRACTION * est.dt_max * (1.0 + 1e-12), "{what}: {est:?}");
+    assert!(
+        l.resolved.network.dt <= DT_FRACTION * est.dt_max * (1.0 + 1e-12),
+        "{what}: {est:?}"
+    );
     if scheme == SchemeKind::ObserverTimeVarying {
-        assert!(l.resolved.appendix_d_min_eig.expect("scheme 1") > 0.0, "{what}");
+        assert!(
+            l.resolved.appendix_d_min_eig.expect("scheme 1") > 0.0,
+            "{what}"
+        );
     }
     assert!(stays_finite(&l), "{what}: diverged");
 }
@@ -103,7 +110,12 @@ fn the_header_says_why_k_sigma_and_dt() {
     assert!(g.notes[1].contains("largest stable RK4 step"));
     // The example: the doubling loop gave k_σ = 1536 with dt = 1 ms
     // (σ̂ mode ≈ 1.3e4 s⁻¹, NaN by t = 0.01 s); now dt is within the bound.
-    let k = g.scenario.scheme.observer.and_then(|o| o.k_sigma).expect("k_σ");
+    let k = g
+        .scenario
+        .scheme
+        .observer
+        .and_then(|o| o.k_sigma)
+        .expect("k_σ");
     assert!(k > 12.0, "{k}");
     assert!(g.scenario.simulation.dt < 0.001);
 }
@@ -127,8 +139,12 @@ fn the_100_agent_example_stays_finite_and_its_error_falls() {
         };
         toml::to_string(&tree(&p).expect("valid").scenario).expect("serialises")
     };
-    let l = load_str(Path::new("t.toml"), &text, &[format!("output.sample_period={}", dt * 1000.0)])
-        .expect("valid");
+    let l = load_str(
+        Path::new("t.toml"),
+        &text,
+        &[format!("output.sample_period={}", dt * 1000.0)],
+    )
+    .expect("valid");
     let net = &l.resolved.network;
     let mut mean = Vec::new();
     let mut finite = true;

@@ -80,12 +80,22 @@ fn a_stiff_scenario_is_refused_naming_dt_the_bound_and_a_step_that_works() {
     assert_eq!(issues.len(), 1, "{e}");
     let i = &issues[0];
     assert_eq!(i.field, "simulation.dt");
-    assert!(i.reason.contains("dt = 0.001 s exceeds the largest stable step ≈ 3.3e-4 s of the observer loop"), "{i}");
+    assert!(
+        i.reason.contains(
+            "dt = 0.001 s exceeds the largest stable step ≈ 3.3e-4 s of the observer loop"
+        ),
+        "{i}"
+    );
     assert!(i.reason.contains("fastest mode 8.5e3 s⁻¹"), "{i}");
     let fix = i.reason.split("--set ").nth(1).expect("a fix").to_string();
     assert_eq!(fix, "simulation.dt=0.00025");
     let ok = load(&paper("timevarying.toml"), &sets(&[STIFF_SIGMA, &fix])).expect("the fix works");
-    assert!(ok.resolved.warnings.iter().all(|w| w.field != "simulation.dt"));
+    assert!(
+        ok.resolved
+            .warnings
+            .iter()
+            .all(|w| w.field != "simulation.dt")
+    );
 }
 
 #[test]
@@ -123,16 +133,30 @@ fn a_step_close_to_the_bound_is_warned_about_not_refused() {
     }
     assert!(load_dt("timevarying.toml", &[STIFF_SIGMA], 2.1 * bound, 100, check).is_err());
     let l = load_dt("timevarying.toml", &[STIFF_SIGMA], 0.7 * bound, 100, check).expect("valid");
-    assert!(l.resolved.warnings.iter().all(|w| w.field != "simulation.dt"));
+    assert!(
+        l.resolved
+            .warnings
+            .iter()
+            .all(|w| w.field != "simulation.dt")
+    );
 }
 
 #[test]
 fn the_paper_scenarios_have_a_wide_margin() {
-    for f in ["timevarying.toml", "constant-observer.toml", "constant-observerless.toml"] {
+    for f in [
+        "timevarying.toml",
+        "constant-observer.toml",
+        "constant-observerless.toml",
+    ] {
         let l = load(&paper(f), &[]).expect("valid");
         let est = l.resolved.stiffness.expect("agents");
         assert!(est.dt_max > 10.0 * l.resolved.network.dt, "{f}: {est:?}");
-        assert!(l.resolved.warnings.iter().all(|w| w.field != "simulation.dt"));
+        assert!(
+            l.resolved
+                .warnings
+                .iter()
+                .all(|w| w.field != "simulation.dt")
+        );
     }
 }
 
@@ -146,15 +170,29 @@ fn just_below_the_bound_stays_finite_well_above_diverges() {
     let cases: [(&str, &str, f64); 4] = [
         ("timevarying.toml", STIFF_SIGMA, 0.95),
         ("timevarying.toml", "scheme.control.k_omega=2000", 0.95),
-        ("constant-observer.toml", "scheme.observer.k_omega=3000", 0.95),
-        ("constant-observerless.toml", "scheme.control.k_r=3000", 0.95),
+        (
+            "constant-observer.toml",
+            "scheme.observer.k_omega=3000",
+            0.95,
+        ),
+        (
+            "constant-observerless.toml",
+            "scheme.control.k_r=3000",
+            0.95,
+        ),
     ];
     for (file, set, below) in cases {
         let bound = dt_max(file, &[set]);
         let l = with_dt(file, &[set], below * bound, 4000);
-        assert!(stays_finite(&l.resolved.network), "{file} {set}: diverged at {below}·dt_max");
+        assert!(
+            stays_finite(&l.resolved.network),
+            "{file} {set}: diverged at {below}·dt_max"
+        );
         let l = with_dt(file, &[set], 2.5 * bound, 1500);
-        assert!(!stays_finite(&l.resolved.network), "{file} {set}: finite at 2.5·dt_max");
+        assert!(
+            !stays_finite(&l.resolved.network),
+            "{file} {set}: finite at 2.5·dt_max"
+        );
     }
 }
 
@@ -174,7 +212,10 @@ fn cli_refuses_a_stiff_scenario_unless_told_not_to() {
         .expect("runs");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("simulation.dt: dt = 0.001 s exceeds the largest stable step"), "{err}");
+    assert!(
+        err.contains("simulation.dt: dt = 0.001 s exceeds the largest stable step"),
+        "{err}"
+    );
     assert!(err.contains("try --set simulation.dt=0.00025"), "{err}");
     let out = std::process::Command::new(bin)
         .arg("check")
@@ -185,14 +226,26 @@ fn cli_refuses_a_stiff_scenario_unless_told_not_to() {
         .expect("runs");
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{text}");
-    assert!(text.contains("largest stable dt 3.268e-4 s for dt = 0.001 s: margin dt_max/dt = 0.327"), "{text}");
-    assert!(text.contains("(not refused: --no-stiffness-check)"), "{text}");
+    assert!(
+        text.contains("largest stable dt 3.268e-4 s for dt = 0.001 s: margin dt_max/dt = 0.327"),
+        "{text}"
+    );
+    assert!(
+        text.contains("(not refused: --no-stiffness-check)"),
+        "{text}"
+    );
     let dir = tempfile::tempdir().expect("tempdir");
     let out = std::process::Command::new(bin)
         .arg("run")
         .arg(&file)
         .args(set)
-        .args(["--set", "simulation.duration=0.02", "--engine", "in-process", "--quiet"])
+        .args([
+            "--set",
+            "simulation.duration=0.02",
+            "--engine",
+            "in-process",
+            "--quiet",
+        ])
         .arg("--no-stiffness-check")
         .arg("--out")
         .arg(dir.path().join("r"))
@@ -200,6 +253,9 @@ fn cli_refuses_a_stiff_scenario_unless_told_not_to() {
         .expect("runs");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_ne!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("warning:") && err.contains("simulation.dt"), "{err}");
+    assert!(
+        err.contains("warning:") && err.contains("simulation.dt"),
+        "{err}"
+    );
     assert!(dir.path().join("r/errors.csv").exists(), "{err}");
 }

@@ -78,7 +78,10 @@ pub fn describe(l: &Loaded) -> String {
 /// The step-size estimate (`docs/stiffness.md`): per loop its fastest linear
 /// mode and largest stable RK4 step, then the scenario's and its margin.
 fn stiffness(s: &mut String, e: &Estimate, dt: f64) {
-    let _ = writeln!(s, "step size (RK4 on the linearised loops, docs/stiffness.md):");
+    let _ = writeln!(
+        s,
+        "step size (RK4 on the linearised loops, docs/stiffness.md):"
+    );
     for l in &e.loops {
         let _ = writeln!(
             s,

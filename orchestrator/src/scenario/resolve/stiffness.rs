@@ -67,12 +67,18 @@ pub(super) fn loops(net: &Network, graph: Interval) -> Option<Vec<Loop>> {
         j,
     };
     Some(match scheme {
-        Scheme::ObserverTimeVarying { observer: o, control } => vec![
+        Scheme::ObserverTimeVarying {
+            observer: o,
+            control,
+        } => vec![
             observer(&o, Some(net.p)),
             tracking(&control),
             Loop::Leader { p: net.p },
         ],
-        Scheme::ObserverConstant { observer: o, control } => {
+        Scheme::ObserverConstant {
+            observer: o,
+            control,
+        } => {
             vec![observer(&o, None), tracking(&control)]
         }
         Scheme::Observerless { control } => vec![Loop::Observerless {

@@ -2,8 +2,8 @@
 
 use super::{EngineArgs, ScenarioArgs};
 use attsync::Error;
-use attsync::options::StiffnessCheck;
 use attsync::interrupt::Interrupt;
+use attsync::options::StiffnessCheck;
 use attsync::run::{self, RunOptions};
 use std::io::IsTerminal;
 use std::path::PathBuf;
