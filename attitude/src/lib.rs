@@ -22,6 +22,7 @@
 //! - [`engine`]: all nodes in one process, in lockstep.
 //! - [`metrics`]: the reported errors.
 //! - [`checks`]: the paper's conditions on gains and on `P`.
+//! - [`stiffness`]: the fastest linear modes of each loop and RK4's largest stable `dt`.
 
 pub mod agent;
 pub mod body;
@@ -36,3 +37,4 @@ pub mod observer;
 pub mod reference;
 pub mod schedule;
 pub mod so3;
+pub mod stiffness;

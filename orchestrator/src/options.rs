@@ -8,6 +8,10 @@
 //! - `--realtime` factor: finite, > 0 and at most [`MAX_REALTIME`];
 //! - `--tolerance`, `--quantum`: finite and > 0;
 //! - `--jobs`: ≥ 1; `--bisect`: 1..=[`MAX_BISECT`].
+//!
+//! `--no-stiffness-check` (`run`, `check`, `sweep`) is a [`StiffnessCheck`]:
+//! it turns validation's refusal of a `simulation.dt` clearly beyond RK4's
+//! largest stable step (`docs/stiffness.md`) into a warning.
 
 use crate::conform::ConformOptions;
 use crate::generate::TreeParams;
@@ -25,6 +29,29 @@ pub const MAX_REALTIME: f64 = 1e6;
 /// Most bisection iterations (each halves the bracket: 64 reach f64's
 /// resolution of any bracket).
 pub const MAX_BISECT: u32 = 64;
+
+/// What validation does with a `simulation.dt` clearly beyond the largest
+/// stable RK4 step of the scenario's loops (`docs/stiffness.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StiffnessCheck {
+    /// Refuse the scenario (exit code 2), naming a `dt` that would work.
+    #[default]
+    Refuse,
+    /// Only warn (`--no-stiffness-check`): the run goes on and may diverge.
+    Warn,
+}
+
+impl StiffnessCheck {
+    /// The policy of the flag `--no-stiffness-check` (`true` if given).
+    #[must_use]
+    pub fn from_flag(no_stiffness_check: bool) -> Self {
+        if no_stiffness_check {
+            Self::Warn
+        } else {
+            Self::Refuse
+        }
+    }
+}
 
 /// An option that cannot be used.
 #[derive(Debug, Clone, PartialEq, Error)]

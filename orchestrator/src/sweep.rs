@@ -11,7 +11,7 @@
 //! the step `simulation.dt` for a timing field ([`default_quantum`]).
 
 use crate::interrupt::Interrupt;
-use crate::options::{self, OptionError};
+use crate::options::{self, OptionError, StiffnessCheck};
 use crate::results::layout::SweepLayout;
 use crate::results::staging::Staging;
 use crate::run::{Engine, RunError, RunOptions, run};
@@ -42,6 +42,8 @@ pub struct SweepOptions {
     /// Bisect between the first value that does not converge and the one
     /// before it, for the margin.
     pub find_margin: Option<Bisection>,
+    /// What validation does with a step beyond RK4's stable one (`--no-stiffness-check`).
+    pub stiffness: StiffnessCheck,
 }
 
 /// How the margin is bisected.
@@ -140,10 +142,11 @@ pub fn load_checked(
     set: &[String],
     param: &str,
     values: &[String],
+    check: StiffnessCheck,
 ) -> Result<Loaded, ScenarioError> {
-    let loaded = scenario::load(scenario, set)?;
+    let loaded = scenario::load_with(scenario, set, check)?;
     for v in values {
-        scenario::load(scenario, &overrides(set, param, v))?;
+        scenario::load_with(scenario, &overrides(set, param, v), check)?;
     }
     Ok(loaded)
 }
@@ -232,7 +235,11 @@ fn run_one(
     value: &str,
     interrupt: &Interrupt,
 ) -> Result<SweepRow, SweepError> {
-    let loaded = scenario::load(&o.scenario, &overrides(&o.set, &o.param, value))?;
+    let loaded = scenario::load_with(
+        &o.scenario,
+        &overrides(&o.set, &o.param, value),
+        o.stiffness,
+    )?;
     let name = crate::results::layout::sweep_run_name(k, value);
     let opts = RunOptions {
         out: SweepLayout::new(dir).run(k, value).root().to_owned(),
@@ -312,7 +319,7 @@ fn run_many(
 /// See [`SweepError`]; an interrupted sweep leaves nothing behind.
 pub fn sweep(o: &SweepOptions, interrupt: &Interrupt) -> Result<SweepResult, SweepError> {
     o.validate()?;
-    let base = load_checked(&o.scenario, &o.set, &o.param, &o.values)?;
+    let base = load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
     let staging = Staging::new(&o.run.out).map_err(io_at(&o.run.out))?;
     let dir = staging.path().to_owned();
     let mut rows = run_many(o, &dir, 0, &o.values, interrupt)?;
@@ -567,6 +574,7 @@ mod tests {
                 iterations: 8,
                 quantum: None,
             }),
+            stiffness: StiffnessCheck::Refuse,
         }
     }
 
@@ -590,13 +598,21 @@ mod tests {
     fn every_value_is_checked_before_anything_runs() {
         let set = ["simulation.duration=0.1".to_string()];
         let ok = ["0".to_string(), "0.01".to_string()];
-        let base = load_checked(&paper(), &set, "network.delay", &ok).expect("valid");
+        let base = load_checked(&paper(), &set, "network.delay", &ok, StiffnessCheck::Refuse)
+            .expect("valid");
         assert_eq!(
             default_out(&base, "agent[2].omega"),
             PathBuf::from(format!("results/{}-sweep-agent_2__omega", base.name()))
         );
         let bad = ["0".to_string(), "-1".to_string()];
-        let e = load_checked(&paper(), &set, "network.delay", &bad).unwrap_err();
+        let e = load_checked(
+            &paper(),
+            &set,
+            "network.delay",
+            &bad,
+            StiffnessCheck::Refuse,
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("network.delay"), "{e}");
     }
 

@@ -698,14 +698,23 @@ fn duration_must_be_a_positive_multiple_of_dt() {
             .steps,
         2000
     );
-    let l = valid(
+    // dt = 0.1 s is beyond RK4's stable step of BASE's tracking loop
+    // (docs/stiffness.md), refused unless --no-stiffness-check; the rule
+    // tested here is the multiple of dt.
+    let sets: Vec<String> = [
+        "simulation.dt=0.1",
+        "simulation.duration=0.3",
+        "output.sample_period=0.1",
+    ]
+    .map(String::from)
+    .to_vec();
+    let l = attsync::scenario::load_str_with(
+        Path::new(FILE),
         BASE,
-        &[
-            "simulation.dt=0.1",
-            "simulation.duration=0.3",
-            "output.sample_period=0.1",
-        ],
-    );
+        &sets,
+        attsync::options::StiffnessCheck::Warn,
+    )
+    .unwrap_or_else(|e| panic!("expected a valid scenario, got:\n{e}"));
     assert_eq!(l.resolved.network.steps, 3);
 }
 

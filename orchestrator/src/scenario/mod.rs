@@ -33,6 +33,7 @@ pub use error::ScenarioError;
 pub use resolve::{Issue, Resolved};
 pub use schema::Scenario;
 
+use crate::options::StiffnessCheck;
 use std::path::{Path, PathBuf};
 
 /// A scenario as loaded: the effective document (after overrides), its
@@ -63,17 +64,37 @@ impl Loaded {
 }
 
 /// Reads (at most [`input::MAX_FILE_BYTES`]), overrides, parses and
-/// validates a scenario file.
+/// validates a scenario file (a `simulation.dt` clearly beyond the largest
+/// stable step is refused).
 pub fn load(file: &Path, overrides: &[String]) -> Result<Loaded, ScenarioError> {
+    load_with(file, overrides, StiffnessCheck::Refuse)
+}
+
+/// As [`load`], with the stiffness verdict `check` (`--no-stiffness-check`).
+pub fn load_with(
+    file: &Path,
+    overrides: &[String],
+    check: StiffnessCheck,
+) -> Result<Loaded, ScenarioError> {
     let text = input::read_bounded(file).map_err(|error| ScenarioError::Io {
         file: file.to_owned(),
         error,
     })?;
-    load_str(file, &text, overrides)
+    load_str_with(file, &text, overrides, check)
 }
 
 /// As [`load`], from text already read (`file` is used in messages).
 pub fn load_str(file: &Path, text: &str, overrides: &[String]) -> Result<Loaded, ScenarioError> {
+    load_str_with(file, text, overrides, StiffnessCheck::Refuse)
+}
+
+/// As [`load_str`], with the stiffness verdict `check`.
+pub fn load_str_with(
+    file: &Path,
+    text: &str,
+    overrides: &[String],
+    check: StiffnessCheck,
+) -> Result<Loaded, ScenarioError> {
     let file_buf = file.to_owned();
     let (document, scenario) = parse::parse(text, overrides).map_err(|f| match f {
         parse::Failure::Syntax(issue) => ScenarioError::Parse {
@@ -103,7 +124,7 @@ pub fn load_str(file: &Path, text: &str, overrides: &[String]) -> Result<Loaded,
     };
     let dir = std::path::absolute(&dir).unwrap_or(dir);
     let resolved = match (
-        resolve::resolve(&scenario),
+        resolve::resolve_with(&scenario, check),
         plugin::resolve(&scenario, &dir),
     ) {
         (Ok(r), Ok(plugins)) => Ok(resolve::Resolved { plugins, ..r }),

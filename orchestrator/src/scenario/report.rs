@@ -3,6 +3,7 @@
 use super::Loaded;
 use super::resolve::kind_name;
 use attitude::network::Coupling;
+use attitude::stiffness::Estimate;
 use std::fmt::Write as _;
 
 /// A human-readable description of a validated scenario.
@@ -65,8 +66,43 @@ pub fn describe(l: &Loaded) -> String {
             if m > 0.0 { "holds" } else { "FAILS" }
         );
     }
+    if let Some(e) = &r.stiffness {
+        stiffness(&mut s, e, n.dt);
+    }
     for w in &r.warnings {
         let _ = writeln!(s, "warning: {w}");
     }
     s
+}
+
+/// The step-size estimate (`docs/stiffness.md`): per loop its fastest linear
+/// mode and largest stable RK4 step, then the scenario's and its margin.
+fn stiffness(s: &mut String, e: &Estimate, dt: f64) {
+    let _ = writeln!(
+        s,
+        "step size (RK4 on the linearised loops, docs/stiffness.md):"
+    );
+    for l in &e.loops {
+        let _ = writeln!(
+            s,
+            "  {:<12} fastest mode {:.3e} s⁻¹  largest stable dt {}",
+            l.name,
+            l.fastest_rate,
+            seconds(l.dt_max)
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  largest stable dt {} for dt = {dt} s: margin dt_max/dt = {:.3}",
+        seconds(e.dt_max),
+        e.dt_max / dt
+    );
+}
+
+fn seconds(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x:.3e} s")
+    } else {
+        "unlimited".into()
+    }
 }

@@ -13,7 +13,9 @@
 //! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check);
 //! - `checks` — reachability from the leader, spectrum, Appendix D;
 //! - `network` — `[network]`, `[[network.link]]`;
-//! - `assemble` — the [`Network`] from the parts, once there are no errors.
+//! - `assemble` — the [`Network`] from the parts, once there are no errors;
+//! - `stiffness` — on the assembled network: `simulation.dt` against RK4's
+//!   largest stable step ([`stable_dt`], [`REFUSE_FACTOR`], [`WARN_FROM`]).
 
 mod agents;
 mod assemble;
@@ -25,9 +27,14 @@ mod network;
 mod rotation;
 mod scheme;
 mod simulation;
+mod stiffness;
+
+pub use stiffness::{REFUSE_FACTOR, WARN_FROM, stable_dt};
 
 use super::schema::{Scenario, SchemeKind};
+use crate::options::StiffnessCheck;
 use attitude::network::Network;
+use attitude::stiffness::Estimate;
 use ctx::Ctx;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -62,13 +69,23 @@ pub struct Resolved {
     pub spectrum: Vec<f64>,
     /// Smallest eigenvalue of Appendix D's `F` (scheme 1 only).
     pub appendix_d_min_eig: Option<f64>,
+    /// The fastest linear mode of each loop and RK4's largest stable step
+    /// (`None` without agents).
+    pub stiffness: Option<Estimate>,
     /// Agents run by the user's own programs.
     pub plugins: Vec<super::plugin::Plugin>,
 }
 
-/// Validates `s` and resolves it into a [`Network`]. Returns every error
-/// found (not only the first).
+/// Validates `s` and resolves it into a [`Network`], refusing a
+/// `simulation.dt` clearly beyond the largest stable step. Returns every
+/// error found (not only the first).
 pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
+    resolve_with(s, StiffnessCheck::Refuse)
+}
+
+/// As [`resolve`], with the stiffness verdict `check` (the step-size phase
+/// runs last, on an otherwise valid scenario).
+pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec<Issue>> {
     let mut c = Ctx::default();
     let kind = s.scheme.kind;
     simulation::name(&mut c, s.name.as_ref());
@@ -96,13 +113,19 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         bodies,
         impaired,
     };
+    let network = assemble::network(parts, &edges, &links);
+    let estimate = stiffness::stiffness(&mut c, &network, &spectrum.eigenvalues, check);
+    if !c.errors.is_empty() {
+        return Err(c.errors);
+    }
     Ok(Resolved {
-        network: assemble::network(parts, &edges, &links),
+        network,
         warnings: c.warnings,
         leader_links: links.gain.keys().copied().collect(),
         edges: edges.pairs,
         spectrum: spectrum.eigenvalues,
         appendix_d_min_eig: spectrum.appendix_d_min_eig,
+        stiffness: estimate,
         plugins: Vec::new(),
     })
 }

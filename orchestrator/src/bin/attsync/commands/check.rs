@@ -3,10 +3,11 @@
 
 use super::ScenarioArgs;
 use attsync::Error;
+use attsync::options::StiffnessCheck;
 use attsync::processes::{self, ProcessOptions};
 use std::path::Path;
 
-/// `attsync check SCENARIO [--set K=V]… [--node-config ID]`.
+/// `attsync check SCENARIO [--set K=V]… [--node-config ID] [--no-stiffness-check]`.
 #[derive(Debug, clap::Args)]
 pub struct Check {
     #[command(flatten)]
@@ -15,11 +16,17 @@ pub struct Check {
     /// receive (PROTOCOL.md; `run` and `iox_root` are placeholders).
     #[arg(long, value_name = "ID")]
     pub node_config: Option<u32>,
+    /// Do not refuse a simulation.dt beyond the largest stable RK4 step of
+    /// the scenario's loops (docs/stiffness.md): warn, and run anyway.
+    #[arg(long)]
+    pub no_stiffness_check: bool,
 }
 
 /// Prints the network, or node `--node-config`'s configuration.
 pub fn exec(a: Check) -> Result<(), Error> {
-    let loaded = a.scenario.load()?;
+    let loaded = a
+        .scenario
+        .load(StiffnessCheck::from_flag(a.no_stiffness_check))?;
     let Some(id) = a.node_config else {
         print!("{}", attsync::scenario::report::describe(&loaded));
         return Ok(());

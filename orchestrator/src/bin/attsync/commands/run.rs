@@ -3,12 +3,14 @@
 use super::{EngineArgs, ScenarioArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
+use attsync::options::StiffnessCheck;
 use attsync::run::{self, RunOptions};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// `attsync run SCENARIO [--engine E] [--wait W] [--stage-timeout S]
-/// [--realtime [FACTOR]] [--out DIR] [--set K=V]… [--quiet]`.
+/// [--realtime [FACTOR]] [--out DIR] [--set K=V]… [--quiet]
+/// [--no-stiffness-check]`.
 #[derive(Debug, clap::Args)]
 pub struct Run {
     #[command(flatten)]
@@ -27,6 +29,10 @@ pub struct Run {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// Do not refuse a simulation.dt beyond the largest stable RK4 step of
+    /// the scenario's loops (docs/stiffness.md): warn, and run anyway.
+    #[arg(long)]
+    pub no_stiffness_check: bool,
 }
 
 /// Runs the scenario, prints its summary; an incomplete run is an error
@@ -39,7 +45,9 @@ pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
         progress: !a.quiet && std::io::stderr().is_terminal(),
     };
     opts.validate()?;
-    let loaded = a.scenario.load()?;
+    let loaded = a
+        .scenario
+        .load(StiffnessCheck::from_flag(a.no_stiffness_check))?;
     for w in &loaded.resolved.warnings {
         eprintln!("warning: {}: {w}", loaded.file.display());
     }

@@ -4,6 +4,7 @@
 use super::{EngineArgs, ScenarioArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
+use attsync::options::StiffnessCheck;
 use attsync::run::RunOptions;
 use attsync::sweep::{self, Bisection, SweepOptions};
 use std::path::PathBuf;
@@ -39,6 +40,10 @@ pub struct Sweep {
     /// Round bisection points to multiples of this [default: simulation.dt for delays, jitters and periods, else none].
     #[arg(long)]
     pub quantum: Option<f64>,
+    /// Do not refuse a simulation.dt beyond the largest stable RK4 step of
+    /// the scenario's loops (docs/stiffness.md): warn, and run anyway.
+    #[arg(long)]
+    pub no_stiffness_check: bool,
 }
 
 /// Runs the sweep and prints its table.
@@ -60,9 +65,10 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
             iterations: a.bisect,
             quantum: a.quantum,
         }),
+        stiffness: StiffnessCheck::from_flag(a.no_stiffness_check),
     };
     o.validate()?;
-    let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values)?;
+    let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
     let nodes = base.resolved.network.agents.len() + 1;
     let cores = sweep::cores();
     match a.jobs {
