@@ -22,6 +22,8 @@
 //! - [`engine`]: all nodes in one process, in lockstep.
 //! - [`metrics`]: the reported errors.
 //! - [`checks`]: the paper's conditions on gains and on `P`.
+//! - [`spectrum`]: extremes of `Ξ + LLᵀ` and Appendix `appenD`'s `F ≻ 0`, sparse (no dense matrix).
+//! - [`sparse`]: sparse symmetric `LDLᵀ` / block Cholesky in a minimum-degree order (no fill-in on a forest).
 
 pub mod agent;
 pub mod body;
@@ -36,3 +38,5 @@ pub mod observer;
 pub mod reference;
 pub mod schedule;
 pub mod so3;
+pub mod sparse;
+pub mod spectrum;
