@@ -11,63 +11,46 @@ use std::cmp::Reverse;
 use std::collections::{BTreeSet, BinaryHeap};
 
 /// An elimination order of a graph and the filled graph it implies, in
-/// compressed rows: node `v`'s later neighbours are
-/// `later[start[v]..start[v + 1]]`, ascending.
+/// compressed rows over *positions* in the order: the later neighbours of
+/// the node at position `k` are `later[start[k]..start[k + 1]]`, ascending.
 #[derive(Debug, Clone)]
 pub struct Elimination {
-    /// Nodes in elimination order.
+    /// Nodes in elimination order (position → node).
     order: Vec<usize>,
-    /// Position of every node in `order`.
+    /// Position of every node in `order` (node → position).
     pos: Vec<usize>,
     /// Row starts into `later` (length `n + 1`).
     start: Vec<usize>,
-    /// Neighbours eliminated after each node, in the filled graph.
+    /// Positions of the neighbours eliminated after each position, in the filled graph.
     later: Vec<usize>,
 }
 
 impl Elimination {
-    /// The minimum-degree order of the graph on `0..n` with `edges` (ties
-    /// by node index; self-loops and repeated pairs ignored).
+    /// An elimination order of the graph on `0..n` with `edges` (self-loops
+    /// ignored): on a forest leaves first (peeling, `O(N)`, no fill-in);
+    /// otherwise minimum degree, ties by node index (repeated pairs count once).
     ///
     /// # Panics
     /// If an edge names a node `≥ n`.
     #[must_use]
     pub fn min_degree(n: usize, edges: &[(usize, usize)]) -> Self {
-        let mut adj: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
-        for &(i, j) in edges {
-            if i != j {
-                adj[i].insert(j);
-                adj[j].insert(i);
-            }
-        }
-        let mut heap: BinaryHeap<Reverse<(usize, usize)>> =
-            (0..n).map(|v| Reverse((adj[v].len(), v))).collect();
-        let mut done = vec![false; n];
-        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); n];
-        let mut order = Vec::with_capacity(n);
-        while let Some(Reverse((d, v))) = heap.pop() {
-            if done[v] || d != adj[v].len() {
-                continue; // a stale entry
-            }
-            done[v] = true;
-            let nb: Vec<usize> = std::mem::take(&mut adj[v]).into_iter().collect();
-            for &a in &nb {
-                adj[a].remove(&v);
-                adj[a].extend(nb.iter().copied().filter(|&b| b != a));
-                heap.push(Reverse((adj[a].len(), a)));
-            }
-            order.push(v);
-            rows[v] = nb;
-        }
-        let mut pos = vec![0; n];
+        let rows = forest_rows(n, edges).unwrap_or_else(|| min_degree_rows(n, edges));
+        Self::from_rows(rows)
+    }
+
+    /// From the order and each eliminated node's later neighbours.
+    fn from_rows((order, rows): (Vec<usize>, Vec<Vec<usize>>)) -> Self {
+        let mut pos = vec![0; order.len()];
         for (k, &v) in order.iter().enumerate() {
             pos[v] = k;
         }
-        let mut start = Vec::with_capacity(n + 1);
+        let mut start = Vec::with_capacity(order.len() + 1);
         start.push(0);
         let mut later = Vec::new();
-        for r in rows {
-            later.extend(r);
+        for &v in &order {
+            let first = later.len();
+            later.extend(rows[v].iter().map(|&w| pos[w]));
+            later[first..].sort_unstable();
             start.push(later.len());
         }
         Self {
@@ -90,6 +73,12 @@ impl Elimination {
         self.order.is_empty()
     }
 
+    /// Position of node `v` in the order.
+    #[must_use]
+    pub fn position(&self, v: usize) -> usize {
+        self.pos[v]
+    }
+
     /// Number of entries of the filled pattern off the diagonal (upper half):
     /// the number of edges on a forest (no fill-in).
     #[must_use]
@@ -97,18 +86,14 @@ impl Elimination {
         self.later.len()
     }
 
-    /// The later neighbours of `v`.
-    fn row(&self, v: usize) -> std::ops::Range<usize> {
-        self.start[v]..self.start[v + 1]
+    /// The later neighbours of position `k`, as a range of `later`.
+    fn row(&self, k: usize) -> std::ops::Range<usize> {
+        self.start[k]..self.start[k + 1]
     }
 
-    /// Index into `later` of the entry `(a, b)` of the filled pattern.
+    /// Index into `later` of the entry between positions `a` and `b`.
     fn entry(&self, a: usize, b: usize) -> usize {
-        let (x, y) = if self.pos[a] < self.pos[b] {
-            (a, b)
-        } else {
-            (b, a)
-        };
+        let (x, y) = (a.min(b), a.max(b));
         let r = self.row(x);
         r.start
             + self.later[r]
@@ -116,16 +101,74 @@ impl Elimination {
                 .expect("an entry of the filled pattern")
     }
 
-    /// Index into `later` of the entry `(i, j)` of the filled pattern (every
-    /// edge is one), and whether `i` is eliminated first (so that the slot
-    /// holds `A_{i,j}`, not its transpose).
+    /// Index into `later` of the entry `(i, j)` (nodes) of the filled
+    /// pattern (every edge is one), and whether `i` is eliminated first (so
+    /// that the slot holds `A_{i,j}`, not its transpose).
     ///
     /// # Panics
     /// If `(i, j)` is not in the pattern.
     #[must_use]
     pub fn slot(&self, i: usize, j: usize) -> (usize, bool) {
-        (self.entry(i, j), self.pos[i] < self.pos[j])
+        let (a, b) = (self.pos[i], self.pos[j]);
+        (self.entry(a, b), a < b)
     }
+}
+
+/// Leaves first, if the graph is a forest (`None` otherwise): each node's
+/// later neighbour is its one remaining neighbour when it is peeled.
+fn forest_rows(n: usize, edges: &[(usize, usize)]) -> Option<(Vec<usize>, Vec<Vec<usize>>)> {
+    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for &(i, j) in edges.iter().filter(|(i, j)| i != j) {
+        adj[i].push(j);
+        adj[j].push(i);
+    }
+    let mut degree: Vec<usize> = adj.iter().map(Vec::len).collect();
+    let mut queue: std::collections::VecDeque<usize> = (0..n).filter(|&v| degree[v] <= 1).collect();
+    let mut done = vec![false; n];
+    let (mut order, mut rows) = (Vec::with_capacity(n), vec![Vec::new(); n]);
+    while let Some(v) = queue.pop_front() {
+        done[v] = true;
+        order.push(v);
+        rows[v] = adj[v].iter().copied().filter(|&u| !done[u]).collect();
+        if rows[v].len() > 1 {
+            return None; // a repeated pair: not a forest
+        }
+        for &u in &rows[v] {
+            degree[u] -= 1;
+            if degree[u] == 1 {
+                queue.push_back(u);
+            }
+        }
+    }
+    (order.len() == n).then_some((order, rows))
+}
+
+/// Minimum degree with explicit fill-in (any graph).
+fn min_degree_rows(n: usize, edges: &[(usize, usize)]) -> (Vec<usize>, Vec<Vec<usize>>) {
+    let mut adj: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
+    for &(i, j) in edges.iter().filter(|(i, j)| i != j) {
+        adj[i].insert(j);
+        adj[j].insert(i);
+    }
+    let mut heap: BinaryHeap<Reverse<(usize, usize)>> =
+        (0..n).map(|v| Reverse((adj[v].len(), v))).collect();
+    let mut done = vec![false; n];
+    let (mut order, mut rows) = (Vec::with_capacity(n), vec![Vec::new(); n]);
+    while let Some(Reverse((d, v))) = heap.pop() {
+        if done[v] || d != adj[v].len() {
+            continue; // a stale entry
+        }
+        done[v] = true;
+        let nb: Vec<usize> = std::mem::take(&mut adj[v]).into_iter().collect();
+        for &a in &nb {
+            adj[a].remove(&v);
+            adj[a].extend(nb.iter().copied().filter(|&b| b != a));
+            heap.push(Reverse((adj[a].len(), a)));
+        }
+        order.push(v);
+        rows[v] = nb;
+    }
+    (order, rows)
 }
 
 /// A symmetric scalar matrix on an [`Elimination`]'s pattern, stored as its
@@ -135,7 +178,8 @@ impl Elimination {
 /// computed without cancellation.
 #[derive(Debug, Clone)]
 pub struct ScalarSym {
-    /// Row sums `rᵥ` (diagonal plus off-diagonal entries).
+    /// Row sums `rᵥ` (diagonal plus off-diagonal entries), by position in
+    /// the order ([`Elimination::position`]).
     pub excess: Vec<f64>,
     /// Off-diagonal entries, one per slot of the filled pattern (0 for fill).
     pub off: Vec<f64>,
@@ -151,7 +195,7 @@ impl ScalarSym {
         let mut r: Vec<f64> = self.excess.iter().map(|x| x - t).collect();
         let mut off = self.off.clone();
         let mut negative = 0;
-        for &v in &g.order {
+        for v in 0..g.len() {
             let row = g.row(v);
             let mut d = r[v] - off[row.clone()].iter().sum::<f64>();
             if d <= 0.0 {
@@ -179,7 +223,7 @@ pub type Block<const B: usize> = [[f64; B]; B];
 /// A symmetric block matrix on an [`Elimination`]'s pattern.
 #[derive(Debug, Clone)]
 pub struct BlockSym<const B: usize> {
-    /// Diagonal blocks, one per node.
+    /// Diagonal blocks, one per node, by position in the order.
     pub diag: Vec<Block<B>>,
     /// Off-diagonal blocks `A_{x,y}` (x eliminated first), one per slot of
     /// the filled pattern (0 for fill).
@@ -187,7 +231,8 @@ pub struct BlockSym<const B: usize> {
 }
 
 impl<const B: usize> BlockSym<B> {
-    /// The matrix with diagonal blocks `diag` and no off-diagonal block yet.
+    /// The matrix with diagonal blocks `diag` (by position) and no
+    /// off-diagonal block yet.
     #[must_use]
     pub fn new(g: &Elimination, diag: Vec<Block<B>>) -> Self {
         Self {
@@ -211,7 +256,7 @@ impl<const B: usize> BlockSym<B> {
         let mut diag = self.diag.clone();
         let mut off = self.off.clone();
         let mut smallest = f64::INFINITY;
-        for &v in &g.order {
+        for v in 0..g.len() {
             let l = cholesky(&diag[v])?;
             (0..B).for_each(|k| smallest = smallest.min(l[k][k] * l[k][k]));
             let row = g.row(v);
@@ -227,7 +272,7 @@ impl<const B: usize> BlockSym<B> {
                     let b = g.later[ib];
                     let wb = &w[ib - row.start];
                     let k = g.entry(a, b);
-                    if g.pos[a] < g.pos[b] {
+                    if a < b {
                         subtract_at_b(&mut off[k], wa, wb);
                     } else {
                         subtract_at_b(&mut off[k], wb, wa);

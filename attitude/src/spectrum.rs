@@ -43,12 +43,15 @@ impl XiPlusLaplacian {
             degree[i] += 1.0;
             degree[j] += 1.0;
         }
-        let excess: Vec<f64> = (0..n).map(|i| f64::from(u8::from(xi[i]))).collect();
-        let d: Vec<f64> = (0..n).map(|i| degree[i] + excess[i]).collect();
-        let diag = d.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &x| {
-            (lo.min(x), hi.max(x))
+        let mut excess = vec![0.0; n];
+        for i in 0..n {
+            excess[g.position(i)] = f64::from(u8::from(xi[i]));
+        }
+        let xi_i = |i: usize| f64::from(u8::from(xi[i]));
+        let diag = (0..n).fold((f64::INFINITY, 0.0_f64), |(lo, hi), i| {
+            (lo.min(degree[i] + xi_i(i)), hi.max(degree[i] + xi_i(i)))
         });
-        let gershgorin = (0..n).map(|i| 2.0 * degree[i] + excess[i]).fold(0.0, f64::max);
+        let gershgorin = (0..n).map(|i| 2.0 * degree[i] + xi_i(i)).fold(0.0, f64::max);
         Self {
             g,
             a: ScalarSym { excess, off },
@@ -177,7 +180,11 @@ pub fn appendix_d_smallest_pivot(
         m[j] += 1.0;
     }
     let pp = p + p.transpose();
-    let diag = m
+    let mut by_position = vec![0.0; n];
+    for (i, &mii) in m.iter().enumerate() {
+        by_position[g.position(i)] = mii;
+    }
+    let diag = by_position
         .iter()
         .map(|&mii| {
             let mut b: Block<6> = [[0.0; 6]; 6];

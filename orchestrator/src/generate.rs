@@ -6,6 +6,7 @@ use crate::scenario::schema::{
     ObserverGainsSpec, ObserverInit, Output, ReferenceKind, RotationSpec, Scenario, SchemeKind,
     SchemeSpec, Simulation,
 };
+use attitude::checks::appendix_d_min_eigenvalue_from_extremes;
 use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -184,15 +185,26 @@ fn paper_scheme_and_leader(kind: SchemeKind) -> (SchemeSpec, LeaderSpec) {
 
 /// For scheme 1, doubles `k_σ` until the matrix F of Appendix D is positive
 /// definite (so that Theorem 1 covers the generated network). Deep trees
-/// need a larger `k_σ` than the paper's 12.
+/// need a larger `k_σ` than the paper's 12. The scenario is resolved once;
+/// each doubling is tested on the extremes of `Ξ + LLᵀ` (which `k_σ` does
+/// not change).
 fn raise_k_sigma_until_theorem_1_holds(s: &mut Scenario) {
+    let Ok(r) = crate::scenario::resolve::resolve(s) else {
+        return;
+    };
+    let mut min_eig = r.appendix_d_min_eig;
     for _ in 0..20 {
-        let Ok(r) = crate::scenario::resolve::resolve(s) else {
-            return;
-        };
-        match (r.appendix_d_min_eig, s.scheme.observer.as_mut()) {
+        match (min_eig, s.scheme.observer.as_mut()) {
             (Some(m), Some(o)) if m <= 0.0 => {
                 o.k_sigma = o.k_sigma.map(|k| k * 2.0);
+                min_eig = o.k_sigma.map(|k| {
+                    appendix_d_min_eigenvalue_from_extremes(
+                        r.spectrum_extremes,
+                        o.k_omega,
+                        k,
+                        &r.network.p,
+                    )
+                });
             }
             _ => return,
         }

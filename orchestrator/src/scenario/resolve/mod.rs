@@ -11,7 +11,8 @@
 //! - `simulation` — `name`, `[simulation]`, `[output]`;
 //! - `scheme` — `[scheme]`; `leader` — `[leader]`; `agents` — `[[agent]]`;
 //! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check);
-//! - `checks` — reachability from the leader, spectrum, Appendix D;
+//! - `checks` — reachability from the leader, spectrum (sparse: extremes
+//!   and count; every eigenvalue only for small N), Appendix D;
 //! - `network` — `[network]`, `[[network.link]]`;
 //! - `assemble` — the [`Network`] from the parts, once there are no errors.
 
@@ -58,8 +59,11 @@ pub struct Resolved {
     pub edges: Vec<(u32, u32)>,
     /// Agents that hear the leader, ascending.
     pub leader_links: Vec<u32>,
-    /// Eigenvalues of `Ξ + LLᵀ`, ascending.
+    /// Eigenvalues of `Ξ + LLᵀ`, ascending, only up to 50 agents (empty
+    /// beyond: see `spectrum_extremes`).
     pub spectrum: Vec<f64>,
+    /// `(λmin, λmax)` of `Ξ + LLᵀ` (its order is the number of agents).
+    pub spectrum_extremes: (f64, f64),
     /// Smallest eigenvalue of Appendix D's `F` (scheme 1 only).
     pub appendix_d_min_eig: Option<f64>,
     /// Agents run by the user's own programs.
@@ -102,6 +106,7 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         leader_links: links.gain.keys().copied().collect(),
         edges: edges.pairs,
         spectrum: spectrum.eigenvalues,
+        spectrum_extremes: (spectrum.lambda_min, spectrum.lambda_max),
         appendix_d_min_eig: spectrum.appendix_d_min_eig,
         plugins: Vec::new(),
     })
