@@ -51,7 +51,9 @@ impl XiPlusLaplacian {
         let diag = (0..n).fold((f64::INFINITY, 0.0_f64), |(lo, hi), i| {
             (lo.min(degree[i] + xi_i(i)), hi.max(degree[i] + xi_i(i)))
         });
-        let gershgorin = (0..n).map(|i| 2.0 * degree[i] + xi_i(i)).fold(0.0, f64::max);
+        let gershgorin = (0..n)
+            .map(|i| 2.0 * degree[i] + xi_i(i))
+            .fold(0.0, f64::max);
         Self {
             g,
             a: ScalarSym { excess, off },
@@ -193,7 +195,8 @@ pub fn appendix_d_smallest_pivot(
                 b[r][r + 3] = -0.5;
                 b[r + 3][r] = -0.5;
                 for c in 0..3 {
-                    b[r + 3][c + 3] = f64::from(u8::from(r == c)) * k_sigma * mii - 0.5 * pp[(r, c)];
+                    b[r + 3][c + 3] =
+                        f64::from(u8::from(r == c)) * k_sigma * mii - 0.5 * pp[(r, c)];
                 }
             }
             b

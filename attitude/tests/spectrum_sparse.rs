@@ -170,13 +170,23 @@ fn a_component_without_a_leader_link_has_lambda_min_zero() {
     xi.extend([false, false]);
     let (lo, hi) = xi_plus_laplacian_extremes(n + 2, &edges, &xi);
     assert_eq!(lo, 0.0);
-    assert_close(hi, *dense_eigs(&(n + 2, edges, xi)).last().unwrap(), 1e-9, "λmax");
+    assert_close(
+        hi,
+        *dense_eigs(&(n + 2, edges, xi)).last().unwrap(),
+        1e-9,
+        "λmax",
+    );
 }
 
 #[test]
 fn forests_eliminate_without_fill_in() {
     let mut rng = Rng(7);
-    for g in [path(200), star(200), forest(), random_tree(&mut rng, 500, 3)] {
+    for g in [
+        path(200),
+        star(200),
+        forest(),
+        random_tree(&mut rng, 500, 3),
+    ] {
         let e = Elimination::min_degree(g.0, &g.1);
         assert_eq!(e.filled_entries(), g.1.len());
     }
@@ -185,7 +195,12 @@ fn forests_eliminate_without_fill_in() {
 #[test]
 fn counts_below_a_threshold_match_dense() {
     let mut rng = Rng(42);
-    for g in [paper(), forest(), with_cycles(), random_tree(&mut rng, 150, 2)] {
+    for g in [
+        paper(),
+        forest(),
+        with_cycles(),
+        random_tree(&mut rng, 150, 2),
+    ] {
         let e = dense_eigs(&g);
         let m = XiPlusLaplacian::new(g.0, &g.1, &g.2);
         for _ in 0..50 {
@@ -219,7 +234,10 @@ fn check_appendix_d(g: &Graph, p: &Matrix3<f64>, seen: &mut [bool; 2]) {
             let fast = appendix_d_min_eigenvalue_from_extremes(ext, k_w, k_s, p);
             let scale = appendix_d_f(&f1, k_w, k_s, p).amax();
             let what = format!("N = {n}, k_ω = {k_w}, k_σ = {k_s}");
-            assert!((fast - dense).abs() <= 1e-9 * scale, "{what}: {fast:e} vs {dense:e}");
+            assert!(
+                (fast - dense).abs() <= 1e-9 * scale,
+                "{what}: {fast:e} vs {dense:e}"
+            );
             let pd = appendix_d_f(&f1, k_w, k_s, p).cholesky().is_some();
             let pivot = appendix_d_smallest_pivot(*n, edges, xi, k_w, k_s, p);
             if dense.abs() > 1e-9 * scale {

@@ -24,7 +24,10 @@ fn attsync_ok(cwd: &Path, args: &[&str]) -> String {
         String::from_utf8(out.stdout).expect("UTF-8"),
         String::from_utf8_lossy(&out.stderr).into_owned(),
     );
-    assert!(out.status.success(), "attsync {args:?} failed:\n{stdout}\n{stderr}");
+    assert!(
+        out.status.success(),
+        "attsync {args:?} failed:\n{stdout}\n{stderr}"
+    );
     stdout
 }
 
@@ -35,8 +38,13 @@ fn summary(stdout: &str) -> (usize, f64, f64) {
         .find(|l| l.starts_with("spectrum of Ξ + LLᵀ: ") && l.contains(" eigenvalues in ["))
         .unwrap_or_else(|| panic!("no spectrum summary:\n{stdout}"));
     let rest = line.trim_start_matches("spectrum of Ξ + LLᵀ: ");
-    let (count, range) = rest.split_once(" eigenvalues in [").expect("the summary's form");
-    let (lo, hi) = range.trim_end_matches(']').split_once(", ").expect("two extremes");
+    let (count, range) = rest
+        .split_once(" eigenvalues in [")
+        .expect("the summary's form");
+    let (lo, hi) = range
+        .trim_end_matches(']')
+        .split_once(", ")
+        .expect("two extremes");
     (
         count.parse().expect("a count"),
         lo.parse().expect("λmin"),
@@ -48,7 +56,10 @@ fn summary(stdout: &str) -> (usize, f64, f64) {
 fn a_generated_tree_of_20000_agents_passes_check() {
     let tmp = tempfile::tempdir().unwrap();
     let args = ["gen", "tree", "--agents", "20000", "--leader-links", "100"];
-    attsync_ok(tmp.path(), &[&args[..], &["--seed", "1", "--out", "big.toml"]].concat());
+    attsync_ok(
+        tmp.path(),
+        &[&args[..], &["--seed", "1", "--out", "big.toml"]].concat(),
+    );
     let out = attsync_ok(tmp.path(), &["check", "big.toml"]);
     let (count, lo, hi) = summary(&out);
     assert_eq!(count, 20000);
@@ -60,7 +71,10 @@ fn a_generated_tree_of_20000_agents_passes_check() {
     assert!(
         out.contains("gain condition (Appendix D, F > 0): holds"),
         "gen raises k_σ until F > 0:\n{}",
-        out.lines().filter(|l| l.contains("gain")).collect::<Vec<_>>().join("\n")
+        out.lines()
+            .filter(|l| l.contains("gain"))
+            .collect::<Vec<_>>()
+            .join("\n")
     );
     // gen's k_σ is the first doubling that makes F ≻ 0: half of it fails.
     let text = std::fs::read_to_string(tmp.path().join("big.toml")).unwrap();
@@ -70,14 +84,20 @@ fn a_generated_tree_of_20000_agents_passes_check() {
         .expect("k_sigma in the generated file")
         .parse()
         .unwrap();
-    assert!(k_sigma > 12.0, "a deep tree needs more than the paper's k_σ");
+    assert!(
+        k_sigma > 12.0,
+        "a deep tree needs more than the paper's k_σ"
+    );
     let half = format!("scheme.observer.k_sigma={}", k_sigma / 2.0);
     let out = attsync_ok(tmp.path(), &["check", "big.toml", "--set", &half]);
     assert!(
         out.contains("gain condition (Appendix D, F > 0): FAILS"),
         "k_σ = {}:\n{}",
         k_sigma / 2.0,
-        out.lines().filter(|l| l.contains("gain")).collect::<Vec<_>>().join("\n")
+        out.lines()
+            .filter(|l| l.contains("gain"))
+            .collect::<Vec<_>>()
+            .join("\n")
     );
 }
 
@@ -100,6 +120,14 @@ fn the_summary_agrees_with_the_full_list_on_the_paper_scenario() {
         .collect();
     assert_eq!(count, eigs.len());
     // The list is printed to 6 decimals, the summary to 7 significant digits.
-    assert!((lo - eigs[0]).abs() < 1e-6 + 1e-6 * lo, "{lo} vs {}", eigs[0]);
-    assert!((hi - eigs[count - 1]).abs() < 1e-6 * hi, "{hi} vs {}", eigs[count - 1]);
+    assert!(
+        (lo - eigs[0]).abs() < 1e-6 + 1e-6 * lo,
+        "{lo} vs {}",
+        eigs[0]
+    );
+    assert!(
+        (hi - eigs[count - 1]).abs() < 1e-6 * hi,
+        "{hi} vs {}",
+        eigs[count - 1]
+    );
 }
