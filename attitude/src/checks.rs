@@ -3,6 +3,10 @@
 
 use nalgebra::{DMatrix, Matrix3};
 
+pub use crate::spectrum::{
+    appendix_d_min_eigenvalue_from_extremes, appendix_d_smallest_pivot, xi_plus_laplacian_extremes,
+};
+
 /// Relative tolerance for symmetry checks.
 const SYM_TOL: f64 = 1e-12;
 
@@ -57,7 +61,8 @@ pub fn p_is_admissible(p: &Matrix3<f64>) -> bool {
     true
 }
 
-/// `Ξ + LLᵀ` (N × N): the Laplacian of the follower graph plus the leader
+/// `Ξ + LLᵀ` (N × N, dense: the reference for small N; see
+/// [`crate::spectrum`] for large N): the Laplacian of the follower graph plus the leader
 /// incidence on the diagonal (`F₁` of Appendix `appenD` without `⊗ I₃`).
 ///
 /// `edges` are pairs of indices in `0..n`; `xi[i]` is `Ξᵢ`.
@@ -116,6 +121,8 @@ pub fn appendix_d_f(f1: &DMatrix<f64>, k_w: f64, k_sigma: f64, p: &Matrix3<f64>)
 /// The paper turns this into the bound
 /// `k_σ > (λmin(F₁⁻¹) − 4k_ω λmin(−½(P+Pᵀ))) / (4k_ω λmin(F₁))` through a
 /// misuse of Weyl's inequality; the eigenvalue of `F` itself is the exact test.
+/// Dense (`6N × 6N`): the reference; [`appendix_d_min_eigenvalue_from_extremes`]
+/// gives the same figure from the extremes of `Ξ + LLᵀ`.
 #[must_use]
 pub fn appendix_d_min_eigenvalue(
     f1: &DMatrix<f64>,

@@ -23,6 +23,8 @@
 //! - [`metrics`]: the reported errors.
 //! - [`checks`]: the paper's conditions on gains and on `P`.
 //! - [`stiffness`]: the fastest linear modes of each loop and RK4's largest stable `dt`.
+//! - [`spectrum`]: extremes of `Ξ + LLᵀ` and Appendix `appenD`'s `F ≻ 0`, sparse (no dense matrix).
+//! - [`sparse`]: sparse symmetric `LDLᵀ` / block Cholesky in a minimum-degree order (no fill-in on a forest).
 
 pub mod agent;
 pub mod body;
@@ -38,3 +40,5 @@ pub mod reference;
 pub mod schedule;
 pub mod so3;
 pub mod stiffness;
+pub mod sparse;
+pub mod spectrum;

@@ -11,7 +11,7 @@ use crate::scenario::schema::{
     ObserverGainsSpec, ObserverInit, Output, ReferenceKind, RotationSpec, Scenario, SchemeKind,
     SchemeSpec, Simulation,
 };
-use attitude::checks::{appendix_d_min_eigenvalue, sym_eigenvalues, xi_plus_laplacian};
+use attitude::checks::{appendix_d_min_eigenvalue_from_extremes, sym_eigenvalues};
 use nalgebra::Matrix3;
 use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
@@ -225,7 +225,9 @@ fn pick_k_sigma(s: &mut Scenario) -> Option<String> {
     let o = s.scheme.observer.as_mut()?;
     let paper = o.k_sigma?;
     let p = r.network.p;
-    let threshold = k_sigma_threshold(&r.spectrum, o.k_omega, &p);
+    // The threshold is decreasing in λ > 0: λmin decides it.
+    let (lo, hi) = r.spectrum_extremes;
+    let threshold = k_sigma_threshold(&[lo, hi], o.k_omega, &p);
     let mut k = paper.max(K_SIGMA_MARGIN * threshold);
     // The exact test, once: a round-off at the boundary only ever asks for more.
     for _ in 0..8 {
@@ -243,20 +245,7 @@ fn pick_k_sigma(s: &mut Scenario) -> Option<String> {
 /// Whether `F > 0` (Appendix D) for `k_σ`: the one call of the exact test
 /// (dense today; a sparse test replaces this line).
 fn f_is_positive_definite(r: &Resolved, k_w: f64, k_sigma: f64, p: &Matrix3<f64>) -> bool {
-    let f1 = xi_plus_laplacian_of(r);
-    appendix_d_min_eigenvalue(&f1, k_w, k_sigma, p) > 0.0
-}
-
-/// `Ξ + LLᵀ` of a resolved scenario (agents in id order).
-fn xi_plus_laplacian_of(r: &Resolved) -> nalgebra::DMatrix<f64> {
-    let net = &r.network;
-    let idx = |id: u32| net.index_of(id).expect("a resolved edge joins agents");
-    let edges: Vec<(usize, usize)> = r.edges.iter().map(|&(a, b)| (idx(a), idx(b))).collect();
-    let mut xi = vec![false; net.agents.len()];
-    for &id in &r.leader_links {
-        xi[idx(id)] = true;
-    }
-    xi_plus_laplacian(net.agents.len(), &edges, &xi)
+    appendix_d_min_eigenvalue_from_extremes(r.spectrum_extremes, k_w, k_sigma, p) > 0.0
 }
 
 /// The boundary `k_σ*` of `F > 0`. With `F₁ = (Ξ + LLᵀ) ⊗ I₃ > 0`, `F > 0`

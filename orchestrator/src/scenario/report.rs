@@ -57,8 +57,16 @@ pub fn describe(l: &Loaded) -> String {
     let _ = writeln!(s, "edges:     {}", edges.join(", "));
     let links: Vec<String> = r.leader_links.iter().map(|a| format!("0→{a}")).collect();
     let _ = writeln!(s, "leader:    {}", links.join(", "));
-    let spec: Vec<String> = r.spectrum.iter().map(|e| format!("{e:.6}")).collect();
-    let _ = writeln!(s, "spectrum of Ξ + LLᵀ: [{}]", spec.join(", "));
+    let (lo, hi) = r.spectrum_extremes;
+    let _ = writeln!(
+        s,
+        "spectrum of Ξ + LLᵀ: {} eigenvalues in [{lo:.6e}, {hi:.6e}]",
+        n.agents.len()
+    );
+    if !r.spectrum.is_empty() {
+        let spec: Vec<String> = r.spectrum.iter().map(|e| format!("{e:.6}")).collect();
+        let _ = writeln!(s, "spectrum of Ξ + LLᵀ: [{}]", spec.join(", "));
+    }
     if let Some(m) = r.appendix_d_min_eig {
         let _ = writeln!(
             s,

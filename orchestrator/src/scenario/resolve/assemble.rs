@@ -33,6 +33,7 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
     } = parts;
     let scheme = scheme.expect("no errors");
     let p = leader.p;
+    let incident = incident_edges(edges);
     let agents = bodies
         .into_iter()
         .map(|(id, (inertia, a_bar, initial))| AgentSpec {
@@ -40,7 +41,12 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
                 id,
                 inertia,
                 a_bar,
-                neighbours: neighbours(id, edges, &impaired),
+                neighbours: neighbours(
+                    id,
+                    incident.get(&id).map_or(&[], Vec::as_slice),
+                    edges,
+                    &impaired,
+                ),
                 leader_gain: links.gain.get(&id).copied(),
                 leader_link: impaired.get(&(0, id)).copied(),
                 scheme,
@@ -65,30 +71,34 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
 }
 
 /// The neighbours of agent `id`, by ascending id, with the link each of
-/// their messages to `id` crosses.
+/// their messages to `id` crosses (`incident`: the edges at `id`).
 fn neighbours(
     id: u32,
+    incident: &[(u32, u32)],
     edges: &Edges,
     impaired: &BTreeMap<(u32, u32), LinkModel>,
 ) -> Vec<Neighbour> {
-    let mut neighbours: Vec<Neighbour> = edges
-        .pairs
+    let mut neighbours: Vec<Neighbour> = incident
         .iter()
-        .filter_map(|&(a, b)| {
-            let other = if a == id {
-                b
-            } else if b == id {
-                a
-            } else {
-                return None;
-            };
-            Some(Neighbour {
+        .map(|&(a, b)| {
+            let other = if a == id { b } else { a };
+            Neighbour {
                 link: impaired.get(&(other, id)).copied(),
                 id: other,
                 a: edges.gain[&(a, b)],
-            })
+            }
         })
         .collect();
     neighbours.sort_by_key(|n| n.id);
     neighbours
+}
+
+/// The edges at every agent, in file order (one pass over the edges).
+fn incident_edges(edges: &Edges) -> BTreeMap<u32, Vec<(u32, u32)>> {
+    let mut at: BTreeMap<u32, Vec<(u32, u32)>> = BTreeMap::new();
+    for &(a, b) in &edges.pairs {
+        at.entry(a).or_default().push((a, b));
+        at.entry(b).or_default().push((a, b));
+    }
+    at
 }

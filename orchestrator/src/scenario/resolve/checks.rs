@@ -4,7 +4,9 @@
 
 use super::ctx::Ctx;
 use super::graph::{Edges, LeaderLinks};
-use attitude::checks::{appendix_d_min_eigenvalue, xi_plus_laplacian};
+use attitude::checks::{
+    appendix_d_min_eigenvalue_from_extremes, xi_plus_laplacian, xi_plus_laplacian_extremes,
+};
 use attitude::network::Scheme;
 use nalgebra::{DMatrix, Matrix3};
 use std::collections::{BTreeMap, BTreeSet};
@@ -45,16 +47,26 @@ pub(super) fn reachability(
     }
 }
 
-/// What the graph's matrices say.
+/// Up to this many agents the full spectrum of `Ξ + LLᵀ` is computed
+/// (dense) and printed; beyond, only its extremes and count.
+pub(super) const FULL_SPECTRUM_UP_TO: usize = 50;
+
+/// What the graph's matrices say (`Ξ + LLᵀ` has one eigenvalue per agent).
 pub(super) struct Spectrum {
-    /// Eigenvalues of `Ξ + LLᵀ`, ascending.
+    /// Smallest eigenvalue of `Ξ + LLᵀ` (`NaN` without agents).
+    pub(super) lambda_min: f64,
+    /// Largest eigenvalue of `Ξ + LLᵀ` (`NaN` without agents).
+    pub(super) lambda_max: f64,
+    /// Every eigenvalue of `Ξ + LLᵀ`, ascending, only up to
+    /// [`FULL_SPECTRUM_UP_TO`] agents (empty beyond).
     pub(super) eigenvalues: Vec<f64>,
     /// Smallest eigenvalue of Appendix D's `F` (scheme 1 without errors).
     pub(super) appendix_d_min_eig: Option<f64>,
 }
 
-/// The spectrum of `Ξ + LLᵀ`, and (scheme 1, only on a consistent
-/// scenario) Appendix D's condition, a warning when it fails.
+/// The spectrum of `Ξ + LLᵀ` (sparse: extremes by bisection, no dense
+/// matrix beyond [`FULL_SPECTRUM_UP_TO`] agents), and (scheme 1, only on a
+/// consistent scenario) Appendix D's condition, a warning when it fails.
 pub(super) fn spectrum(
     c: &mut Ctx,
     ids: &BTreeMap<u32, usize>,
@@ -70,11 +82,17 @@ pub(super) fn spectrum(
         .map(|(a, b)| (index[a], index[b]))
         .collect();
     let xi: Vec<bool> = ids.keys().map(|id| links.seen.contains_key(id)).collect();
-    let f1 = xi_plus_laplacian(ids.len(), &idx_edges, &xi);
+    let n = ids.len();
+    let (lambda_min, lambda_max) = xi_plus_laplacian_extremes(n, &idx_edges, &xi);
     let mut appendix_d_min_eig = None;
     if let Some(Scheme::ObserverTimeVarying { observer, .. }) = scheme {
         if c.errors.is_empty() {
-            let m = appendix_d_min_eigenvalue(&f1, observer.k_w, observer.k_sigma, p);
+            let m = appendix_d_min_eigenvalue_from_extremes(
+                (lambda_min, lambda_max),
+                observer.k_w,
+                observer.k_sigma,
+                p,
+            );
             appendix_d_min_eig = Some(m);
             if m <= 0.0 {
                 c.warn(
@@ -84,8 +102,15 @@ pub(super) fn spectrum(
             }
         }
     }
+    let eigenvalues = if n <= FULL_SPECTRUM_UP_TO {
+        sorted_eigs(&xi_plus_laplacian(n, &idx_edges, &xi))
+    } else {
+        Vec::new()
+    };
     Spectrum {
-        eigenvalues: sorted_eigs(&f1),
+        lambda_min,
+        lambda_max,
+        eigenvalues,
         appendix_d_min_eig,
     }
 }

@@ -134,14 +134,18 @@ struct Dsu {
 }
 
 impl Dsu {
-    fn find(&mut self, x: u32) -> u32 {
-        let p = *self.parent.entry(x).or_insert(x);
-        if p == x {
-            return x;
+    /// The representative of `x`'s set (iterative, with path halving: no
+    /// recursion however deep the chain of parents).
+    fn find(&mut self, mut x: u32) -> u32 {
+        loop {
+            let p = *self.parent.entry(x).or_insert(x);
+            if p == x {
+                return x;
+            }
+            let g = self.parent[&p];
+            self.parent.insert(x, g);
+            x = g;
         }
-        let r = self.find(p);
-        self.parent.insert(x, r);
-        r
     }
 
     /// Joins the sets of `a` and `b`; `false` if they were already joined.

@@ -11,7 +11,8 @@
 //! - `simulation` — `name`, `[simulation]`, `[output]`;
 //! - `scheme` — `[scheme]`; `leader` — `[leader]`; `agents` — `[[agent]]`;
 //! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check);
-//! - `checks` — reachability from the leader, spectrum, Appendix D;
+//! - `checks` — reachability from the leader, spectrum (sparse: extremes
+//!   and count; every eigenvalue only for small N), Appendix D;
 //! - `network` — `[network]`, `[[network.link]]`;
 //! - `assemble` — the [`Network`] from the parts, once there are no errors;
 //! - `stiffness` — on the assembled network: `simulation.dt` against RK4's
@@ -65,8 +66,11 @@ pub struct Resolved {
     pub edges: Vec<(u32, u32)>,
     /// Agents that hear the leader, ascending.
     pub leader_links: Vec<u32>,
-    /// Eigenvalues of `Ξ + LLᵀ`, ascending.
+    /// Eigenvalues of `Ξ + LLᵀ`, ascending, only up to 50 agents (empty
+    /// beyond: see `spectrum_extremes`).
     pub spectrum: Vec<f64>,
+    /// `(λmin, λmax)` of `Ξ + LLᵀ` (its order is the number of agents).
+    pub spectrum_extremes: (f64, f64),
     /// Smallest eigenvalue of Appendix D's `F` (scheme 1 only).
     pub appendix_d_min_eig: Option<f64>,
     /// The fastest linear mode of each loop and RK4's largest stable step
@@ -114,7 +118,10 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         impaired,
     };
     let network = assemble::network(parts, &edges, &links);
-    let estimate = stiffness::stiffness(&mut c, &network, &spectrum.eigenvalues, check);
+    // The extremes of Ξ + LLᵀ are all the estimate needs (none without agents).
+    let extremes = [spectrum.lambda_min, spectrum.lambda_max];
+    let graph = if network.agents.is_empty() { &[][..] } else { &extremes[..] };
+    let estimate = stiffness::stiffness(&mut c, &network, graph, check);
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
@@ -124,6 +131,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         leader_links: links.gain.keys().copied().collect(),
         edges: edges.pairs,
         spectrum: spectrum.eigenvalues,
+        spectrum_extremes: (spectrum.lambda_min, spectrum.lambda_max),
         appendix_d_min_eig: spectrum.appendix_d_min_eig,
         stiffness: estimate,
         plugins: Vec::new(),
