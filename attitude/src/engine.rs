@@ -5,6 +5,7 @@
 //! bit-identical trajectories.
 
 use crate::agent::Agent;
+use crate::guard::{self, Divergence};
 use crate::network::{AgentState, Network};
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::Schedule;
@@ -103,19 +104,38 @@ impl InProcess {
         }
     }
 
+    /// The first node (the leader, then agents in network order) whose
+    /// current state is outside the network's envelope ([`crate::guard`]).
+    #[must_use]
+    pub fn divergence(&self) -> Option<Divergence> {
+        guard::first(&self.net, self.step, self.leader.state(), &self.states)
+    }
+
     /// Runs to the end, calling `on_sample` at t = 0 and every
-    /// `sample_every` steps. Stops early if `on_sample` returns `false`.
-    pub fn run(&mut self, mut on_sample: impl FnMut(&Snapshot<'_>) -> bool) {
-        if self.step == 0 && !on_sample(&self.snapshot()) {
-            return;
+    /// `sample_every` steps. Stops early if `on_sample` returns `false`,
+    /// and at once (before sampling) when a state leaves the envelope:
+    /// then it returns the divergence. The state is checked at t = 0 and
+    /// after every step.
+    pub fn run(&mut self, mut on_sample: impl FnMut(&Snapshot<'_>) -> bool) -> Option<Divergence> {
+        if self.step == 0 {
+            if let Some(d) = self.divergence() {
+                return Some(d);
+            }
+            if !on_sample(&self.snapshot()) {
+                return None;
+            }
         }
         while self.step < self.net.steps {
             self.step();
+            if let Some(d) = self.divergence() {
+                return Some(d);
+            }
             if (self.step % self.net.sample_every == 0 || self.step == self.net.steps)
                 && !on_sample(&self.snapshot())
             {
-                return;
+                return None;
             }
         }
+        None
     }
 }
