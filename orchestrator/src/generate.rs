@@ -81,6 +81,7 @@ pub fn tree(p: &TreeParams) -> Result<Scenario, String> {
         agents,
         edges,
         network: Default::default(),
+        guard: Default::default(),
     };
     raise_k_sigma_until_theorem_1_holds(&mut scenario);
     Ok(scenario)

@@ -6,6 +6,7 @@ use super::startup::POLL;
 use super::{Failure, Ports, Session};
 use crate::outcome::Outcome;
 use attitude::engine::Snapshot;
+use attitude::guard::{self, Divergence, Envelope, Violation};
 use attitude::link::LinkStats;
 use attitude::network::AgentState;
 use attitude::reference::LeaderState;
@@ -77,6 +78,11 @@ pub(crate) struct Collector {
     pub blamed: Vec<(usize, u32)>,
     /// Ids of nodes a receiver caught breaking the protocol.
     pub broke_protocol: Vec<u32>,
+    /// (node index, divergence): the nodes that left the envelope,
+    /// reported by themselves or found in their samples.
+    pub diverged: Vec<(usize, Divergence)>,
+    /// The envelope every sample is checked against.
+    pub guard: Envelope,
 }
 
 impl Collector {
@@ -88,6 +94,8 @@ impl Collector {
             links: Vec::new(),
             blamed: Vec::new(),
             broke_protocol: Vec::new(),
+            diverged: Vec::new(),
+            guard: Envelope::default(),
         }
     }
 
@@ -116,26 +124,44 @@ impl Collector {
         let t = m
             .decode()
             .map_err(|e| format!("node {}'s telemetry: {e}", m.sender))?;
-        self.take(i, t);
-        Ok(())
+        self.take(i, t)
     }
 
-    /// Books report `t` of node index `i`.
-    fn take(&mut self, i: usize, t: Telemetry) {
-        let slot = &mut self.slots[i];
+    /// Books report `t` of node index `i`; a sample is checked first
+    /// ([`Collector::check_sample`]).
+    fn take(&mut self, i: usize, t: Telemetry) -> Result<(), Failure> {
+        let env = self.guard;
         match t {
-            Telemetry::Ready => slot.ready = true,
+            Telemetry::Ready => self.slots[i].ready = true,
             Telemetry::Sample {
                 step,
                 state,
                 peak_torque,
             } => {
-                slot.peak_torque = slot.peak_torque.max(peak_torque);
-                slot.pending.push_back((step, Sampled::Agent(state)));
+                if !peak_torque.is_finite() {
+                    return Err(self.sent_garbage(i, "whose peak_torque is not finite"));
+                }
+                if self.check_sample(i, step, guard::check_agent(&state, &env))? {
+                    let slot = &mut self.slots[i];
+                    slot.peak_torque = slot.peak_torque.max(peak_torque);
+                    slot.pending.push_back((step, Sampled::Agent(state)));
+                }
             }
             Telemetry::LeaderSample { step, state } => {
-                slot.pending.push_back((step, Sampled::Leader(state)));
+                if self.check_sample(i, step, guard::check_leader(&state, &env))? {
+                    self.slots[i].pending.push_back((step, Sampled::Leader(state)));
+                }
             }
+            t => self.take_report(i, t),
+        }
+        Ok(())
+    }
+
+    /// Books a report that is not a sample.
+    fn take_report(&mut self, i: usize, t: Telemetry) {
+        let slot = &mut self.slots[i];
+        match t {
+            Telemetry::Ready | Telemetry::Sample { .. } | Telemetry::LeaderSample { .. } => {}
             Telemetry::LinkStats { from, stats } => self.links.push((from, slot.id, stats)),
             Telemetry::Done(d) => {
                 slot.done = true;
@@ -151,9 +177,69 @@ impl Collector {
                         self.broke_protocol.push(from);
                     }
                     FailReason::Other => {}
+                    FailReason::Diverged {
+                        step,
+                        quantity,
+                        value,
+                    } => self.diverged.push((
+                        i,
+                        Divergence {
+                            step,
+                            node: slot.id,
+                            violation: Violation { quantity, value },
+                        },
+                    )),
                 }
             }
         }
+    }
+
+    /// Checks a sample of node index `i` at `step` whose check against
+    /// the envelope gave `violation`: `Ok(true)` to book it; `Ok(false)`
+    /// when a value is out of the envelope or not finite (the node
+    /// diverged: booked as its divergence); an error when an attitude is
+    /// finite but not a rotation (garbage: the node broke the protocol).
+    fn check_sample(
+        &mut self,
+        i: usize,
+        step: u64,
+        violation: Option<Violation>,
+    ) -> Result<bool, Failure> {
+        if self.diverged.iter().any(|&(j, _)| j == i) {
+            return Ok(false); // a diverged node's later samples mean nothing
+        }
+        let Some(violation) = violation else {
+            return Ok(true);
+        };
+        if violation.quantity.is_attitude() && violation.value.is_finite() {
+            let q = violation.quantity.name();
+            return Err(self.sent_garbage(i, &format!("whose attitude {q} is not a rotation")));
+        }
+        let node = self.slots[i].id;
+        let divergence = Divergence {
+            step,
+            node,
+            violation,
+        };
+        self.diverged.push((i, divergence));
+        Ok(false)
+    }
+
+    /// The failure of node index `i`, which sent telemetry `what`.
+    fn sent_garbage(&self, i: usize, what: &str) -> Failure {
+        format!(
+            "{} broke the protocol: it sent telemetry {what}",
+            self.slots[i].label
+        )
+    }
+
+    /// The run's divergence: the earliest step, then the first node (the
+    /// leader, then agents in network order), as the in-process engine
+    /// finds it.
+    pub(crate) fn divergence(&self) -> Option<Divergence> {
+        (self.diverged.iter())
+            .min_by_key(|(i, d)| (d.step, *i))
+            .map(|(_, d)| *d)
     }
 
     /// Whether every node is done and every sample is in a snapshot.
@@ -161,12 +247,19 @@ impl Collector {
         (self.slots.iter()).all(|s| s.done && s.pending.is_empty())
     }
 
-    /// The next complete snapshot, if every node has sent it.
-    fn next_snapshot(&mut self) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, Failure> {
+    /// The next complete snapshot before step `before`, if every node has
+    /// sent it.
+    fn next_snapshot(
+        &mut self,
+        before: u64,
+    ) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, Failure> {
         if self.slots.iter().any(|s| s.pending.is_empty()) {
             return Ok(None);
         }
         let step = self.slots[0].pending[0].0;
+        if step >= before {
+            return Ok(None);
+        }
         if let Some(s) = self.slots.iter().find(|s| s.pending[0].0 != step) {
             return Err(format!(
                 "telemetry out of step: {} at step {}, leader at {step}",
@@ -194,6 +287,7 @@ impl Collector {
         Outcome {
             peak_torques: agents.iter().map(|s| s.peak_torque).collect(),
             steps: self.steps,
+            diverged: self.divergence(),
             failure,
             pacing: (agents.iter())
                 .map(|s| {
@@ -218,12 +312,15 @@ impl Session<'_> {
     ) -> Result<(), Failure> {
         let stall = Duration::from_secs_f64(self.opts.stage_timeout * 2.0);
         let mut last_progress = Instant::now();
+        let mut diverging: Option<Instant> = None;
+        self.nodes.guard = self.net.guard;
         loop {
             self.ports.wait(POLL);
             if self.nodes.drain(&self.ports)? {
                 last_progress = Instant::now();
             }
-            while let Some((step, leader, agents)) = self.nodes.next_snapshot()? {
+            let before = self.nodes.divergence().map_or(u64::MAX, |d| d.step);
+            while let Some((step, leader, agents)) = self.nodes.next_snapshot(before)? {
                 self.nodes.steps = step;
                 let snap = Snapshot {
                     step,
@@ -233,6 +330,17 @@ impl Session<'_> {
                 if !on_sample(&snap) {
                     return Err("stopped by the results writer".into());
                 }
+            }
+            if !self.nodes.diverged.is_empty() {
+                // Every node finishes the step (a diverged node keeps its
+                // ports) and reports its own divergence: wait until they
+                // are quiet, recording the snapshots before it. The text
+                // is the divergence's (`crate::run`).
+                let since = *diverging.get_or_insert_with(Instant::now);
+                if last_progress.elapsed() >= QUIET || since.elapsed() >= SETTLE {
+                    return Err("diverged".into());
+                }
+                continue;
             }
             if self.nodes.finished() {
                 return Ok(());
@@ -247,6 +355,12 @@ impl Session<'_> {
         }
     }
 }
+
+/// After a divergence: the telemetry silent this long, every node has
+/// reported whether it diverged at that step.
+const QUIET: Duration = Duration::from_millis(300);
+/// After a divergence: the longest wait for the other nodes' reports.
+const SETTLE: Duration = Duration::from_secs(5);
 
 #[cfg(test)]
 mod tests {

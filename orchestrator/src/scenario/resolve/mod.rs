@@ -13,6 +13,7 @@
 //! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check);
 //! - `checks` — reachability from the leader, spectrum, Appendix D;
 //! - `network` — `[network]`, `[[network.link]]`;
+//! - `guard` — `[guard]`, the envelope of a sane state;
 //! - `assemble` — the [`Network`] from the parts, once there are no errors.
 
 mod agents;
@@ -20,6 +21,7 @@ mod assemble;
 mod checks;
 mod ctx;
 mod graph;
+mod guard;
 mod leader;
 mod network;
 mod rotation;
@@ -86,6 +88,7 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
     } else {
         BTreeMap::new()
     };
+    let envelope = guard::guard(&mut c, &s.guard);
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
@@ -95,6 +98,7 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
         leader,
         bodies,
         impaired,
+        guard: envelope,
     };
     Ok(Resolved {
         network: assemble::network(parts, &edges, &links),
