@@ -31,6 +31,9 @@ pub struct InProcess {
     nbr_index: Vec<Vec<usize>>,
     step: u64,
     states: Vec<AgentState>,
+    /// The step of the last snapshot `run` handed out, and each agent's
+    /// peak torque then.
+    sampled: (u64, Vec<f64>),
 }
 
 impl InProcess {
@@ -52,6 +55,7 @@ impl InProcess {
             nbr_index,
             step: 0,
             states,
+            sampled: (0, Vec::new()),
         }
     }
 
@@ -104,6 +108,21 @@ impl InProcess {
         }
     }
 
+    /// The step of the last snapshot [`InProcess::run`] handed out, and
+    /// each agent's peak torque at that step (what a diverged run reports).
+    #[must_use]
+    pub fn last_sample(&self) -> (u64, &[f64]) {
+        (self.sampled.0, &self.sampled.1)
+    }
+
+    /// Books the current step as sampled, then hands its snapshot to `f`.
+    fn sample(&mut self, f: &mut impl FnMut(&Snapshot<'_>) -> bool) -> bool {
+        self.sampled.0 = self.step;
+        self.sampled.1.clear();
+        (self.sampled.1).extend(self.agents.iter().map(Agent::peak_torque));
+        f(&self.snapshot())
+    }
+
     /// The first node (the leader, then agents in network order) whose
     /// current state is outside the network's envelope ([`crate::guard`]).
     #[must_use]
@@ -121,7 +140,7 @@ impl InProcess {
             if let Some(d) = self.divergence() {
                 return Some(d);
             }
-            if !on_sample(&self.snapshot()) {
+            if !self.sample(&mut on_sample) {
                 return None;
             }
         }
@@ -131,7 +150,7 @@ impl InProcess {
                 return Some(d);
             }
             if (self.step % self.net.sample_every == 0 || self.step == self.net.steps)
-                && !on_sample(&self.snapshot())
+                && !self.sample(&mut on_sample)
             {
                 return None;
             }

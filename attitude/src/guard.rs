@@ -226,9 +226,12 @@ impl Divergence {
     #[must_use]
     pub fn message(&self, net: &Network) -> String {
         let cause = probable_cause(net).map_or(String::new(), |c| format!(" (probable cause: {c})"));
+        // 9 decimals, trimmed: no binary noise (0.3 s, not 0.30000000000000004 s).
+        let t = format!("{:.9}", self.step as f64 * net.dt);
+        let t = t.trim_end_matches('0').trim_end_matches('.');
         format!(
             "diverged at t = {} s: {}'s {}{cause}",
-            self.step as f64 * net.dt,
+            if t.is_empty() { "0" } else { t },
             self.node_name(),
             self.violation.describe(&net.guard)
         )

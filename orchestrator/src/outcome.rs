@@ -43,9 +43,19 @@ impl Outcome {
             })
             .collect();
         links.sort_by_key(|&(f, t, _)| (f, t));
+        // A diverged run reports what it recorded: the last snapshot's step
+        // and peak torques (as the process engine's last complete snapshot).
+        let (sampled, peaks) = engine.last_sample();
+        let (steps, peak_torques) = match diverged {
+            Some(_) => (sampled, peaks.to_vec()),
+            None => (
+                engine.step_index(),
+                agents.iter().map(|a| a.peak_torque()).collect(),
+            ),
+        };
         Self {
-            peak_torques: agents.iter().map(|a| a.peak_torque()).collect(),
-            steps: engine.step_index(),
+            peak_torques,
+            steps,
             failure: (diverged.is_some() || interrupted).then(|| match diverged {
                 Some(_) => "diverged".to_string(),
                 None => "interrupted".to_string(),

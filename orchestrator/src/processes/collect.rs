@@ -19,8 +19,8 @@ use std::time::{Duration, Instant};
 pub(crate) enum Sampled {
     /// The leader's.
     Leader(LeaderState),
-    /// An agent's.
-    Agent(AgentState),
+    /// An agent's, with its peak torque so far.
+    Agent(AgentState, f64),
 }
 
 /// What the orchestrator knows of one node (its telemetry subscriber is the
@@ -41,6 +41,9 @@ pub(crate) struct NodeSlot {
     pub done: bool,
     /// Largest torque it reported, N·m.
     pub peak_torque: f64,
+    /// Its peak torque in the last complete snapshot, N·m (what a diverged
+    /// run reports, as the in-process engine does).
+    pub snapshot_peak_torque: f64,
     /// Its `Done` report, once it came.
     pub report: Option<Done>,
     /// It reported giving up.
@@ -58,6 +61,7 @@ impl NodeSlot {
             ready: false,
             done: false,
             peak_torque: 0.0,
+            snapshot_peak_torque: 0.0,
             report: None,
             gave_up: false,
         }
@@ -144,7 +148,7 @@ impl Collector {
                 if self.check_sample(i, step, guard::check_agent(&state, &env))? {
                     let slot = &mut self.slots[i];
                     slot.peak_torque = slot.peak_torque.max(peak_torque);
-                    slot.pending.push_back((step, Sampled::Agent(state)));
+                    (slot.pending).push_back((step, Sampled::Agent(state, peak_torque)));
                 }
             }
             Telemetry::LeaderSample { step, state } => {
@@ -266,14 +270,19 @@ impl Collector {
                 s.name, s.pending[0].0
             ));
         }
-        let mut samples = (self.slots.iter_mut())
-            .map(|s| (s.name.as_str(), s.pending.pop_front().expect("non-empty").1));
+        let mut samples = (self.slots.iter_mut()).map(|s| {
+            let sample = s.pending.pop_front().expect("non-empty").1;
+            if let Sampled::Agent(_, peak) = sample {
+                s.snapshot_peak_torque = peak;
+            }
+            (s.name.as_str(), sample)
+        });
         let Some((_, Sampled::Leader(leader))) = samples.next() else {
             return Err("the leader sent an agent's sample".into());
         };
         let agents = samples
             .map(|(name, s)| match s {
-                Sampled::Agent(a) => Ok(a),
+                Sampled::Agent(a, _) => Ok(a),
                 Sampled::Leader(_) => Err(format!("{name} sent the leader's sample")),
             })
             .collect::<Result<_, _>>()?;
@@ -284,10 +293,16 @@ impl Collector {
     pub(crate) fn outcome(mut self, failure: Option<Failure>) -> Outcome {
         self.links.sort_by_key(|&(f, t, _)| (f, t));
         let agents = &self.slots[1..];
+        let diverged = self.divergence();
         Outcome {
-            peak_torques: agents.iter().map(|s| s.peak_torque).collect(),
+            peak_torques: (agents.iter())
+                .map(|s| match diverged {
+                    Some(_) => s.snapshot_peak_torque,
+                    None => s.peak_torque,
+                })
+                .collect(),
             steps: self.steps,
-            diverged: self.divergence(),
+            diverged,
             failure,
             pacing: (agents.iter())
                 .map(|s| {
