@@ -225,7 +225,8 @@ impl Divergence {
     /// sigma_hat = 3.2e5 exceeds the envelope 1e4 (probable cause: …)`.
     #[must_use]
     pub fn message(&self, net: &Network) -> String {
-        let cause = probable_cause(net).map_or(String::new(), |c| format!(" (probable cause: {c})"));
+        let cause =
+            probable_cause(net).map_or(String::new(), |c| format!(" (probable cause: {c})"));
         // 9 decimals, trimmed: no binary noise (0.3 s, not 0.30000000000000004 s).
         let t = format!("{:.9}", self.step as f64 * net.dt);
         let t = t.trim_end_matches('0').trim_end_matches('.');
@@ -255,7 +256,8 @@ pub fn first(
         })
     };
     at(0, check_leader(leader, &net.guard)).or_else(|| {
-        (net.agents.iter().zip(agents)).find_map(|(a, x)| at(a.model.id, check_agent(x, &net.guard)))
+        (net.agents.iter().zip(agents))
+            .find_map(|(a, x)| at(a.model.id, check_agent(x, &net.guard)))
     })
 }
 
@@ -319,7 +321,10 @@ mod tests {
         let v = check_agent(&x, &Envelope::default()).expect("NaN");
         assert_eq!(v.quantity, Quantity::Omega);
         assert!(v.value.is_nan());
-        assert_eq!(v.describe(&Envelope::default()), "omega is NaN (not finite)");
+        assert_eq!(
+            v.describe(&Envelope::default()),
+            "omega is NaN (not finite)"
+        );
         x.r[(1, 2)] = f64::NEG_INFINITY;
         let v = check_agent(&x, &Envelope::default()).expect("-inf");
         assert_eq!((v.quantity, v.value), (Quantity::R, f64::NEG_INFINITY));
@@ -332,7 +337,10 @@ mod tests {
         let v = check_agent(&x, &Envelope::default()).expect("2·I");
         assert_eq!(v.quantity, Quantity::RHat);
         assert!((v.value - 3.0 * 3f64.sqrt()).abs() < 1e-12, "{v:?}");
-        assert!(v.describe(&Envelope::default()).starts_with("r_hat is not a rotation"));
+        assert!(
+            v.describe(&Envelope::default())
+                .starts_with("r_hat is not a rotation")
+        );
         // A reflection has no orthogonality defect but det = −1.
         x.r_hat = -Matrix3::identity();
         let v = check_agent(&x, &Envelope::default()).expect("−I");

@@ -9,9 +9,7 @@
 //! and no row of `errors.csv` invents an error (no `1` for a NaN state). A
 //! plug-in that reports garbage in its telemetry fails the run, named.
 
-use attsync_tests::{
-    Attsync, Sandbox, assert_same_results, bin, paper, read, run_args, summary,
-};
+use attsync_tests::{Attsync, Sandbox, assert_same_results, bin, paper, read, run_args, summary};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -34,9 +32,16 @@ fn diverges_alike(tmp: &Sandbox, scenario: &Path, sets: &[&str]) -> Value {
     let s = summary(&p);
     assert_eq!(s["complete"], false, "{s:#}");
     assert_eq!(summary(&i)["diverged"], s["diverged"]);
-    let reason = s["incomplete_reason"].as_str().expect("a reason").to_owned();
+    let reason = s["incomplete_reason"]
+        .as_str()
+        .expect("a reason")
+        .to_owned();
     assert!(reason.starts_with("diverged at t = "), "{reason}");
-    assert!(processes.stderr.contains(&reason), "{}", processes.describe());
+    assert!(
+        processes.stderr.contains(&reason),
+        "{}",
+        processes.describe()
+    );
     assert_no_invented_errors(&p.join("errors.csv"));
     s
 }
@@ -47,7 +52,10 @@ fn assert_no_invented_errors(csv: &Path) {
     for row in read(csv).lines().skip(1) {
         let f: Vec<&str> = row.split(',').collect();
         let nan = f.iter().any(|x| *x == "NaN");
-        assert!(!(nan && (f[2] == "1" || f[4] == "1")), "invented error: {row}");
+        assert!(
+            !(nan && (f[2] == "1" || f[4] == "1")),
+            "invented error: {row}"
+        );
         if nan {
             assert!(f[2] == "NaN", "a NaN state with a finite att_err: {row}");
         }
@@ -77,7 +85,11 @@ fn a_state_beyond_the_envelope_stops_both_engines_alike() {
 fn a_nan_state_stops_both_engines_alike_and_reads_back_as_nan() {
     let tmp = Sandbox::new("diverge-nan");
     // An envelope so wide that only a non-finite value trips it.
-    let wide = ["guard.omega=1e300", "guard.omega_hat=1e300", "guard.sigma_hat=1e300"];
+    let wide = [
+        "guard.omega=1e300",
+        "guard.omega_hat=1e300",
+        "guard.sigma_hat=1e300",
+    ];
     let sets: Vec<&str> = STIFF.iter().chain(&wide).copied().collect();
     let s = diverges_alike(&tmp, &paper("timevarying"), &sets);
     let d = &s["diverged"];
@@ -94,13 +106,29 @@ fn the_generated_100_agent_tree_diverges_alike_in_both_engines() {
     let tmp = Sandbox::new("diverge-tree");
     let tree = tmp.join("t.toml");
     Attsync::new(tmp.path())
-        .args(["gen", "tree", "--agents", "100", "--leader-links", "3", "--seed", "1"])
+        .args([
+            "gen",
+            "tree",
+            "--agents",
+            "100",
+            "--leader-links",
+            "3",
+            "--seed",
+            "1",
+        ])
         .args(["--out".as_ref(), tree.as_os_str()])
         .output()
         .assert_ok();
     let s = diverges_alike(&tmp, &tree, &["simulation.duration=2"]);
-    assert!(s["diverged"]["node"].as_str().is_some_and(|n| n.starts_with("agent-")));
-    assert!(s["max_final_att_err"].as_f64().is_some_and(|e| e < 1.0), "{s:#}");
+    assert!(
+        s["diverged"]["node"]
+            .as_str()
+            .is_some_and(|n| n.starts_with("agent-"))
+    );
+    assert!(
+        s["max_final_att_err"].as_f64().is_some_and(|e| e < 1.0),
+        "{s:#}"
+    );
 }
 
 /// The observerless paper scenario with agent 3 the fixture `broken_agent`
@@ -124,13 +152,22 @@ fn a_plugin_reporting_nan_telemetry_diverges_named() {
     let scenario = with_broken_agent_3(&tmp, "nan-telemetry");
     let out = tmp.join("out");
     let r = Attsync::new(tmp.path())
-        .args(run_args(&scenario, "processes", &out, &["simulation.duration=0.5"]))
+        .args(run_args(
+            &scenario,
+            "processes",
+            &out,
+            &["simulation.duration=0.5"],
+        ))
         .output();
     r.assert_code(DIVERGED).assert_no_leftovers();
     let s = summary(&out);
     assert_eq!(s["complete"], false);
     let d = &s["diverged"];
-    assert_eq!((&d["node"], &d["quantity"]), (&"agent-3".into(), &"omega".into()), "{s:#}");
+    assert_eq!(
+        (&d["node"], &d["quantity"]),
+        (&"agent-3".into(), &"omega".into()),
+        "{s:#}"
+    );
     assert_eq!(d["t"], 0.01, "{s:#}");
     assert!(d["value"].is_null(), "{s:#}");
     let reason = s["incomplete_reason"].as_str().unwrap();
@@ -145,7 +182,12 @@ fn a_plugin_reporting_a_non_rotation_breaks_the_protocol_named() {
     let scenario = with_broken_agent_3(&tmp, "bad-telemetry");
     let out = tmp.join("out");
     let r = Attsync::new(tmp.path())
-        .args(run_args(&scenario, "processes", &out, &["simulation.duration=0.5"]))
+        .args(run_args(
+            &scenario,
+            "processes",
+            &out,
+            &["simulation.duration=0.5"],
+        ))
         .output();
     r.assert_code(1).assert_no_leftovers();
     let s = summary(&out);
@@ -154,7 +196,9 @@ fn a_plugin_reporting_a_non_rotation_breaks_the_protocol_named() {
     let reason = s["incomplete_reason"].as_str().unwrap();
     assert!(
         reason.starts_with("agent-3 (plug-in `")
-            && reason.contains("broke the protocol: it sent telemetry whose attitude r is not a rotation"),
+            && reason.contains(
+                "broke the protocol: it sent telemetry whose attitude r is not a rotation"
+            ),
         "{reason}"
     );
 }

@@ -153,7 +153,9 @@ impl Collector {
             }
             Telemetry::LeaderSample { step, state } => {
                 if self.check_sample(i, step, guard::check_leader(&state, &env))? {
-                    self.slots[i].pending.push_back((step, Sampled::Leader(state)));
+                    self.slots[i]
+                        .pending
+                        .push_back((step, Sampled::Leader(state)));
                 }
             }
             t => self.take_report(i, t),
@@ -416,5 +418,74 @@ mod tests {
         m.kind = 99;
         let e = c.accept(1, &m).expect_err("an unknown kind");
         assert!(e.starts_with("node 3's telemetry"), "{e}");
+    }
+
+    fn sample(step: u64, w1: f64, r_scale: f64) -> TelemetryMsg {
+        let state = AgentState {
+            r: nalgebra::Matrix3::identity() * r_scale,
+            w: nalgebra::Vector3::new(0.0, w1, 0.0),
+            r_hat: nalgebra::Matrix3::identity(),
+            w_hat: nalgebra::Vector3::zeros(),
+            s_hat: nalgebra::Vector3::zeros(),
+        };
+        let t = Telemetry::Sample {
+            step,
+            state,
+            peak_torque: 1.0,
+        };
+        TelemetryMsg::encode(3, &t)
+    }
+
+    #[test]
+    fn a_nan_sample_is_the_nodes_divergence_and_is_not_booked() {
+        let mut c = two_nodes();
+        c.accept(1, &sample(0, 1.0, 1.0)).expect("a sane sample");
+        c.accept(1, &sample(10, f64::NAN, 1.0))
+            .expect("a divergence, not an error");
+        assert_eq!(c.slots[1].pending.len(), 1);
+        let d = c.divergence().expect("diverged");
+        assert_eq!((d.step, d.node), (10, 3));
+        assert_eq!(d.violation.quantity, attitude::guard::Quantity::Omega);
+        assert!(d.violation.value.is_nan());
+        // Later samples of a diverged node are not booked either.
+        c.accept(1, &sample(20, 1.0, 1.0)).expect("ignored");
+        assert_eq!(c.slots[1].pending.len(), 1);
+    }
+
+    #[test]
+    fn a_sample_whose_attitude_is_not_a_rotation_fails_naming_the_node() {
+        let mut c = two_nodes();
+        let e = c.accept(1, &sample(0, 1.0, 2.0)).expect_err("2·I");
+        assert_eq!(
+            e,
+            "agent-3 (plug-in `x`) broke the protocol: it sent telemetry whose attitude r is not a rotation"
+        );
+        assert!(c.diverged.is_empty() && c.slots[1].pending.is_empty());
+    }
+
+    #[test]
+    fn the_earliest_divergence_wins_then_the_first_node() {
+        let mut c = two_nodes();
+        let diverged = |step, quantity| {
+            Telemetry::Failed(FailReason::Diverged {
+                step,
+                quantity,
+                value: 2e4,
+            })
+        };
+        use attitude::guard::Quantity;
+        c.accept(
+            1,
+            &TelemetryMsg::encode(3, &diverged(7, Quantity::SigmaHat)),
+        )
+        .expect("booked");
+        c.accept(0, &TelemetryMsg::encode(0, &diverged(7, Quantity::Omega0)))
+            .expect("booked");
+        assert_eq!(c.divergence().map(|d| d.node), Some(0));
+        c.accept(1, &TelemetryMsg::encode(3, &diverged(6, Quantity::R)))
+            .expect("booked");
+        let d = c.divergence().expect("diverged");
+        assert_eq!((d.step, d.node, d.violation.quantity), (6, 3, Quantity::R));
+        assert!(c.slots[1].gave_up);
     }
 }
