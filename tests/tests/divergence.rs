@@ -51,7 +51,7 @@ fn diverges_alike(tmp: &Sandbox, scenario: &Path, sets: &[&str]) -> Value {
 fn assert_no_invented_errors(csv: &Path) {
     for row in read(csv).lines().skip(1) {
         let f: Vec<&str> = row.split(',').collect();
-        let nan = f.iter().any(|x| *x == "NaN");
+        let nan = f.contains(&"NaN");
         assert!(
             !(nan && (f[2] == "1" || f[4] == "1")),
             "invented error: {row}"
