@@ -5,6 +5,7 @@
 //! bit-identical trajectories.
 
 use crate::agent::Agent;
+use crate::guard::{self, Divergence};
 use crate::network::{AgentState, Network};
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::Schedule;
@@ -30,6 +31,9 @@ pub struct InProcess {
     nbr_index: Vec<Vec<usize>>,
     step: u64,
     states: Vec<AgentState>,
+    /// The step of the last snapshot `run` handed out, and each agent's
+    /// peak torque then.
+    sampled: (u64, Vec<f64>),
 }
 
 impl InProcess {
@@ -51,6 +55,7 @@ impl InProcess {
             nbr_index,
             step: 0,
             states,
+            sampled: (0, Vec::new()),
         }
     }
 
@@ -103,19 +108,53 @@ impl InProcess {
         }
     }
 
+    /// The step of the last snapshot [`InProcess::run`] handed out, and
+    /// each agent's peak torque at that step (what a diverged run reports).
+    #[must_use]
+    pub fn last_sample(&self) -> (u64, &[f64]) {
+        (self.sampled.0, &self.sampled.1)
+    }
+
+    /// Books the current step as sampled, then hands its snapshot to `f`.
+    fn sample(&mut self, f: &mut impl FnMut(&Snapshot<'_>) -> bool) -> bool {
+        self.sampled.0 = self.step;
+        self.sampled.1.clear();
+        (self.sampled.1).extend(self.agents.iter().map(Agent::peak_torque));
+        f(&self.snapshot())
+    }
+
+    /// The first node (the leader, then agents in network order) whose
+    /// current state is outside the network's envelope ([`crate::guard`]).
+    #[must_use]
+    pub fn divergence(&self) -> Option<Divergence> {
+        guard::first(&self.net, self.step, self.leader.state(), &self.states)
+    }
+
     /// Runs to the end, calling `on_sample` at t = 0 and every
-    /// `sample_every` steps. Stops early if `on_sample` returns `false`.
-    pub fn run(&mut self, mut on_sample: impl FnMut(&Snapshot<'_>) -> bool) {
-        if self.step == 0 && !on_sample(&self.snapshot()) {
-            return;
+    /// `sample_every` steps. Stops early if `on_sample` returns `false`,
+    /// and at once (before sampling) when a state leaves the envelope:
+    /// then it returns the divergence. The state is checked at t = 0 and
+    /// after every step.
+    pub fn run(&mut self, mut on_sample: impl FnMut(&Snapshot<'_>) -> bool) -> Option<Divergence> {
+        if self.step == 0 {
+            if let Some(d) = self.divergence() {
+                return Some(d);
+            }
+            if !self.sample(&mut on_sample) {
+                return None;
+            }
         }
         while self.step < self.net.steps {
             self.step();
+            if let Some(d) = self.divergence() {
+                return Some(d);
+            }
             if (self.step % self.net.sample_every == 0 || self.step == self.net.steps)
-                && !on_sample(&self.snapshot())
+                && !self.sample(&mut on_sample)
             {
-                return;
+                return None;
             }
         }
+        None
     }
 }

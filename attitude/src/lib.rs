@@ -20,6 +20,7 @@
 //! - [`agent`]: one follower as a stage-by-stage stepper (the exchange protocol).
 //! - [`schedule`]: the stages `(n, s)` of a run and which are exchanges (every loop walks it).
 //! - [`engine`]: all nodes in one process, in lockstep.
+//! - [`guard`]: the envelope of a sane state; divergence as a typed failure.
 //! - [`metrics`]: the reported errors.
 //! - [`checks`]: the paper's conditions on gains and on `P`.
 //! - [`stiffness`]: the fastest linear modes of each loop and RK4's largest stable `dt`.
@@ -31,6 +32,7 @@ pub mod body;
 pub mod checks;
 pub mod control;
 pub mod engine;
+pub mod guard;
 pub mod integrate;
 pub mod link;
 pub mod metrics;

@@ -3,6 +3,7 @@
 use crate::network::AgentState;
 use crate::reference::LeaderState;
 use crate::so3::abs_i;
+use nalgebra::Matrix3;
 
 /// Synchronisation errors of one agent against the leader at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -23,13 +24,58 @@ pub struct Errors {
 #[must_use]
 pub fn errors(x: &AgentState, l: &LeaderState, has_observer: bool) -> Errors {
     Errors {
-        att: abs_i(&(x.r * l.r0.transpose())),
+        att: att_err(&(x.r * l.r0.transpose())),
         angvel: (x.w - l.w0).norm(),
         observer: has_observer.then(|| {
             (
-                abs_i(&(x.r_hat * l.r0.transpose())),
+                att_err(&(x.r_hat * l.r0.transpose())),
                 (x.w_hat - l.w0).norm(),
             )
         }),
+    }
+}
+
+/// `|R|_I` of a relative attitude, NaN if any entry is not finite: a
+/// diverged state has no attitude error (`abs_i` alone would clamp a NaN to 1).
+fn att_err(r: &Matrix3<f64>) -> f64 {
+    if r.iter().all(|v| v.is_finite()) {
+        abs_i(r)
+    } else {
+        f64::NAN
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    #[test]
+    fn a_nan_state_has_nan_errors_never_one() {
+        let l = LeaderState {
+            r0: Matrix3::identity(),
+            w0: Vector3::zeros(),
+            s0: Vector3::zeros(),
+        };
+        let nan = Matrix3::from_element(f64::NAN);
+        let x = AgentState {
+            r: nan,
+            w: Vector3::repeat(f64::NAN),
+            r_hat: nan,
+            w_hat: Vector3::zeros(),
+            s_hat: Vector3::zeros(),
+        };
+        let e = errors(&x, &l, true);
+        assert!(e.att.is_nan() && e.angvel.is_nan(), "{e:?}");
+        assert!(e.observer.is_some_and(|(a, _)| a.is_nan()), "{e:?}");
+        let mut inf = x;
+        inf.r = Matrix3::identity() * f64::INFINITY;
+        assert!(errors(&inf, &l, false).att.is_nan());
+        let fine = AgentState {
+            r: Matrix3::identity(),
+            r_hat: Matrix3::identity(),
+            ..x
+        };
+        assert_eq!(errors(&fine, &l, true).att, 0.0);
     }
 }

@@ -218,6 +218,9 @@ pub struct Network {
     pub coupling: Coupling,
     /// Output sample period, in steps.
     pub sample_every: u64,
+    /// The envelope every node's state must stay in ([`crate::guard`]).
+    #[serde(default)]
+    pub guard: crate::guard::Envelope,
 }
 
 impl Network {

@@ -569,6 +569,7 @@ fn network(observerless: bool, links: Links, steps: u64) -> Network {
         steps,
         coupling: Coupling::Continuous,
         sample_every: 1,
+        guard: Default::default(),
     }
 }
 

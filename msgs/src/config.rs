@@ -4,6 +4,7 @@
 //! node computes bit-identical results to the in-process engine.
 
 use crate::open::Limits;
+use attitude::guard::Envelope;
 use attitude::network::{AgentModel, AgentState, Coupling};
 use attitude::reference::LeaderState;
 use nalgebra::Matrix3;
@@ -82,6 +83,10 @@ pub struct NodeConfig {
     /// inputs; `None` (the default) is deterministic lockstep.
     #[serde(default)]
     pub realtime: Option<f64>,
+    /// The envelope the node's own state must stay in (PROTOCOL.md § 9);
+    /// absent: [`Envelope::default`].
+    #[serde(default, skip_serializing_if = "Envelope::is_default")]
+    pub guard: Envelope,
     /// The node's role and model.
     pub role: Role,
 }

@@ -9,6 +9,7 @@
 //! travels as another type, and unused bytes are 0.
 
 use crate::payload::{PROTOCOL_VERSION, from_rows, to_rows};
+use attitude::guard::Quantity;
 use attitude::link::LinkStats;
 use attitude::network::AgentState;
 use attitude::reference::LeaderState;
@@ -80,7 +81,7 @@ pub struct Pacing {
 }
 
 /// Why a node gave up.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FailReason {
     /// The state of input `from` did not arrive within `stage_timeout`.
     InputTimeout {
@@ -94,6 +95,16 @@ pub enum FailReason {
     },
     /// Anything else (e.g. a receiver that stopped reading its state).
     Other,
+    /// The node's own state left the envelope ([`attitude::guard`]) at
+    /// the end of step `step - 1` (t = step·dt).
+    Diverged {
+        /// The step whose state is out (t = step · dt).
+        step: u64,
+        /// What left the envelope.
+        quantity: Quantity,
+        /// Its value (a norm, a non-finite entry, or an orthogonality defect).
+        value: f64,
+    },
 }
 
 /// Wire codes of [`Telemetry`] kinds (`kind` field).
@@ -131,6 +142,7 @@ impl TelemetryKind {
 const REASON_INPUT_TIMEOUT: u32 = 1;
 const REASON_BAD_INPUT: u32 = 2;
 const REASON_OTHER: u32 = 3;
+const REASON_DIVERGED: u32 = 4;
 
 /// A telemetry message that cannot be decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
@@ -149,6 +161,9 @@ pub enum TelemetryError {
     /// A `Failed` message with an unknown reason code.
     #[error("unknown failure reason {0}")]
     UnknownReason(u32),
+    /// A `Failed` (diverged) message with an unknown quantity code.
+    #[error("unknown diverged quantity {0}")]
+    UnknownQuantity(u32),
 }
 
 /// A node's report to the orchestrator, as it travels. Service
@@ -303,6 +318,16 @@ fn encode_failed(b: &mut Writer, f: &FailReason) {
         FailReason::InputTimeout { from } => (REASON_INPUT_TIMEOUT, from),
         FailReason::BadInput { from } => (REASON_BAD_INPUT, from),
         FailReason::Other => (REASON_OTHER, 0),
+        FailReason::Diverged {
+            step,
+            quantity,
+            value,
+        } => {
+            b.u64(24, step);
+            b.u32(32, quantity.code());
+            b.f64(40, value);
+            (REASON_DIVERGED, 0)
+        }
     };
     b.u32(16, code);
     b.u32(20, from);
@@ -314,6 +339,12 @@ fn decode_failed(b: &Reader) -> Result<FailReason, TelemetryError> {
         REASON_INPUT_TIMEOUT => Ok(FailReason::InputTimeout { from }),
         REASON_BAD_INPUT => Ok(FailReason::BadInput { from }),
         REASON_OTHER => Ok(FailReason::Other),
+        REASON_DIVERGED => Ok(FailReason::Diverged {
+            step: b.u64(24),
+            quantity: Quantity::from_code(b.u32(32))
+                .ok_or(TelemetryError::UnknownQuantity(b.u32(32)))?,
+            value: b.f64(40),
+        }),
         code => Err(TelemetryError::UnknownReason(code)),
     }
 }
@@ -459,6 +490,11 @@ mod tests {
             Telemetry::Failed(FailReason::InputTimeout { from: 5 }),
             Telemetry::Failed(FailReason::BadInput { from: 0 }),
             Telemetry::Failed(FailReason::Other),
+            Telemetry::Failed(FailReason::Diverged {
+                step: 12,
+                quantity: Quantity::SigmaHat,
+                value: 3.2e5,
+            }),
         ];
         for t in all {
             let m = TelemetryMsg::encode(4, &t);
@@ -484,5 +520,36 @@ mod tests {
         let mut m = TelemetryMsg::encode(1, &Telemetry::Failed(FailReason::Other));
         m.body[0] = 77;
         assert_eq!(m.decode(), Err(TelemetryError::UnknownReason(77)));
+        let diverged = FailReason::Diverged {
+            step: 1,
+            quantity: Quantity::R,
+            value: f64::NAN,
+        };
+        let mut m = TelemetryMsg::encode(1, &Telemetry::Failed(diverged));
+        assert_eq!(m.body[16], 1, "quantity code at offset 32");
+        m.body[16] = 99;
+        assert_eq!(m.decode(), Err(TelemetryError::UnknownQuantity(99)));
+    }
+
+    #[test]
+    fn a_diverged_failure_carries_its_nan() {
+        let m = TelemetryMsg::encode(
+            2,
+            &Telemetry::Failed(FailReason::Diverged {
+                step: 7,
+                quantity: Quantity::Omega,
+                value: f64::NAN,
+            }),
+        );
+        assert_eq!(m.body[0], 4, "reason 4 at offset 16");
+        assert_eq!(u64::from_le_bytes(m.body[8..16].try_into().unwrap()), 7);
+        match m.decode() {
+            Ok(Telemetry::Failed(FailReason::Diverged {
+                step: 7,
+                quantity: Quantity::Omega,
+                value,
+            })) => assert!(value.is_nan()),
+            other => panic!("{other:?}"),
+        }
     }
 }

@@ -6,6 +6,7 @@
 //! | 0 | success |
 //! | 2 | invalid scenario, `--set` or option (nothing was started) |
 //! | 1 | any other error (a node died, a rule failed, a file could not be written…) |
+//! | 3 | the run diverged: a state left the envelope (`summary.json` `diverged`) |
 //! | 128 + N | interrupted by signal N: 130 SIGINT, 143 SIGTERM, 129 SIGHUP |
 
 use crate::options::OptionError;
@@ -66,6 +67,7 @@ impl Error {
             Error::Scenario(_) | Error::Options(_) => 2,
             Error::Run(e) => run_code(e),
             Error::RunEnd(RunEnd::Interrupted(signal)) => crate::interrupt::exit_code(*signal),
+            Error::RunEnd(RunEnd::Diverged(_)) => DIVERGED,
             Error::Sweep(e) => match e {
                 SweepError::Scenario(_) | SweepError::Options(_) => 2,
                 SweepError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
@@ -86,6 +88,9 @@ impl Error {
         )
     }
 }
+
+/// The exit code of a run that diverged.
+pub const DIVERGED: u8 = 3;
 
 fn run_code(e: &RunError) -> u8 {
     match e {
@@ -112,6 +117,8 @@ mod tests {
             1
         );
         assert_eq!(Error::NotConforming.exit_code(), 1);
+        let diverged = RunEnd::Diverged("diverged at t = 0.01 s: …".into());
+        assert_eq!(Error::from(diverged).exit_code(), 3);
         assert_eq!(Error::Export("bad file".into()).exit_code(), 1);
         let run = SweepError::Run {
             param: "network.delay".into(),

@@ -101,6 +101,7 @@ pub fn tree(p: &TreeParams) -> Result<Generated, String> {
         agents,
         edges,
         network: Default::default(),
+        guard: Default::default(),
     };
     let notes = [pick_k_sigma(&mut scenario), pick_dt(&mut scenario)]
         .into_iter()

@@ -3,6 +3,7 @@
 //! ([`Outcome::in_process`]).
 
 use attitude::engine::InProcess;
+use attitude::guard::Divergence;
 use attitude::link::LinkStats;
 use msgs::Done;
 
@@ -15,6 +16,9 @@ pub struct Outcome {
     pub steps: u64,
     /// Why the run stopped early, if it did.
     pub failure: Option<String>,
+    /// The state that left the envelope, if the run diverged (then
+    /// `failure` is set too).
+    pub diverged: Option<Divergence>,
     /// Counters of the impaired links: (from, to, stats), by (from, to).
     pub links: Vec<(u32, u32, LinkStats)>,
     /// Real-time pacing per agent (network order): (stages started more
@@ -27,9 +31,9 @@ pub struct Outcome {
 
 impl Outcome {
     /// The outcome of in-process `engine` as it stands (`interrupted`: it was
-    /// stopped by an interrupt).
+    /// stopped by an interrupt; `diverged`: it stopped there).
     #[must_use]
-    pub fn in_process(engine: &InProcess, interrupted: bool) -> Self {
+    pub fn in_process(engine: &InProcess, interrupted: bool, diverged: Option<Divergence>) -> Self {
         let agents = engine.agents();
         let mut links: Vec<(u32, u32, LinkStats)> = agents
             .iter()
@@ -39,10 +43,24 @@ impl Outcome {
             })
             .collect();
         links.sort_by_key(|&(f, t, _)| (f, t));
+        // A diverged run reports what it recorded: the last snapshot's step
+        // and peak torques (as the process engine's last complete snapshot).
+        let (sampled, peaks) = engine.last_sample();
+        let (steps, peak_torques) = match diverged {
+            Some(_) => (sampled, peaks.to_vec()),
+            None => (
+                engine.step_index(),
+                agents.iter().map(|a| a.peak_torque()).collect(),
+            ),
+        };
         Self {
-            peak_torques: agents.iter().map(|a| a.peak_torque()).collect(),
-            steps: engine.step_index(),
-            failure: interrupted.then(|| "interrupted".to_string()),
+            peak_torques,
+            steps,
+            failure: (diverged.is_some() || interrupted).then(|| match diverged {
+                Some(_) => "diverged".to_string(),
+                None => "interrupted".to_string(),
+            }),
+            diverged,
             links,
             pacing: Vec::new(),
             nodes: Vec::new(),

@@ -6,7 +6,7 @@ use crate::options::{self, OptionError};
 use crate::outcome::Outcome;
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::results::layout::RunLayout;
-use crate::results::summary::{LinkSummary, NodeSummary};
+use crate::results::summary::{Diverged, LinkSummary, NodeSummary};
 use crate::results::{self, Recorder, Series, Summary, plot, staging::Staging};
 use crate::scenario::Loaded;
 use attitude::engine::InProcess;
@@ -154,11 +154,11 @@ fn drive(
         Engine::InProcess => {
             let mut engine = InProcess::new(net);
             let mut interrupted = false;
-            engine.run(|snap| {
+            let diverged = engine.run(|snap| {
                 interrupted = interrupt.is_set();
                 !interrupted && record(snap)
             });
-            Outcome::in_process(&engine, interrupted)
+            Outcome::in_process(&engine, interrupted, diverged)
         }
         Engine::Processes => {
             let mut process_opts = opts.processes.clone();
@@ -171,13 +171,19 @@ fn drive(
         return Err(io_at(dir)(e));
     }
     let series = recorder.finish().map_err(io_at(dir))?;
-    // An engine stopped by the interrupt says "interrupted": say which signal.
-    let failure = outcome
-        .failure
-        .map(|f| match f.strip_suffix("interrupted") {
-            Some(blame) if interrupt.is_set() => blame.to_owned() + &interrupted_reason(interrupt),
-            _ => f,
-        });
+    // A diverged run says where, whichever engine ran it. An engine
+    // stopped by the interrupt says "interrupted": say which signal.
+    let failure = match &outcome.diverged {
+        Some(d) => Some(d.message(net, loaded.resolved.stiffness.as_ref())),
+        None => outcome
+            .failure
+            .map(|f| match f.strip_suffix("interrupted") {
+                Some(blame) if interrupt.is_set() => {
+                    blame.to_owned() + &interrupted_reason(interrupt)
+                }
+                _ => f,
+            }),
+    };
     Ok((Outcome { failure, ..outcome }, series))
 }
 
@@ -208,8 +214,9 @@ fn summarise(
         attsync_version: env!("CARGO_PKG_VERSION").into(),
         scenario: loaded.name(),
         engine: opts.engine.name().into(),
-        complete: outcome.failure.is_none() && steps == net.steps,
+        complete: outcome.failure.is_none() && outcome.diverged.is_none() && steps == net.steps,
         incomplete_reason: outcome.failure,
+        diverged: outcome.diverged.map(|d| Diverged::of(&d, net.dt)),
         dt: net.dt,
         duration: net.steps as f64 * net.dt,
         t_end: steps as f64 * net.dt,
@@ -252,6 +259,7 @@ fn interrupted_reason(interrupt: &Interrupt) -> String {
 pub fn verdict(summary: &Summary, interrupt: &Interrupt) -> Result<(), RunEnd> {
     match (&summary.incomplete_reason, interrupt.signal()) {
         (None, _) => Ok(()),
+        (Some(reason), _) if summary.diverged.is_some() => Err(RunEnd::Diverged(reason.clone())),
         (Some(_), Some(signal)) => Err(RunEnd::Interrupted(signal)),
         (Some(reason), None) => Err(RunEnd::Failed(reason.clone())),
     }
@@ -267,6 +275,10 @@ pub enum RunEnd {
     /// in `summary.json`).
     #[error("the run failed: {0}")]
     Failed(String),
+    /// A state left the envelope (`summary.json` `diverged`; the message
+    /// names the time, the node, the quantity and its value).
+    #[error("the run {0}")]
+    Diverged(String),
 }
 
 /// Options that the scenario cannot run with.

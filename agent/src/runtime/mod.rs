@@ -30,6 +30,7 @@ mod realtime;
 pub use attitude::schedule::{Schedule, Slot};
 pub use hooks::{Hooks, NoHooks, Override};
 
+use attitude::guard::{self, Envelope, Violation};
 use attitude::link::LinkStats;
 use attitude::network::Exchanged;
 use hooks::Hooked;
@@ -124,6 +125,16 @@ pub enum NodeError {
     /// The orchestrator said stop, or the shutdown signal was raised, before the end.
     #[error("stopped before the end (at step {0})")]
     Stopped(u64),
+    /// The node's own state left the envelope (`cfg.guard`) after a step.
+    #[error("diverged at step {step}: {what}")]
+    Diverged {
+        /// The step whose state is out (t = step · dt).
+        step: u64,
+        /// What left the envelope.
+        violation: Violation,
+        /// The violation, described.
+        what: String,
+    },
 }
 
 pub(crate) fn port<E: std::fmt::Debug>(what: &'static str) -> impl FnOnce(E) -> NodeError {
@@ -182,6 +193,12 @@ pub fn run_with<S: Service, N: Stepper, H: Hooks>(
             // something else), so that it can name the node that hangs
             // (best effort: we are failing anyway).
             let _ = io.report(Telemetry::Failed(failure(&e)));
+            if matches!(e, NodeError::Diverged { .. }) {
+                // Keep our ports until Stop: the others finish the step
+                // with what we published, and report their own divergence.
+                tracing::error!("{e}");
+                let _ = wait_command(&mut io, STOP_TIMEOUT, shutdown, &orphan);
+            }
             return Err(e);
         }
     };
@@ -285,6 +302,13 @@ fn failure(e: &NodeError) -> FailReason {
     match *e {
         NodeError::InputTimeout { from, .. } => FailReason::InputTimeout { from },
         NodeError::BadInput { from, .. } => FailReason::BadInput { from },
+        NodeError::Diverged {
+            step, violation, ..
+        } => FailReason::Diverged {
+            step,
+            quantity: violation.quantity,
+            value: violation.value,
+        },
         _ => FailReason::Other,
     }
 }
@@ -339,17 +363,35 @@ pub(crate) fn before_step(n: u64, shutdown: &AtomicBool, orphan: &Orphan) -> Res
     orphan.poll()
 }
 
-/// After a step: report a sample if `done` steps make one due.
+/// After a step: check the state against the envelope (PROTOCOL.md § 9),
+/// then report a sample if `done` steps make one due.
 pub(crate) fn after_step<S: Service, N: Stepper, H: Hooks>(
     io: &mut Hooked<'_, S, H>,
     cfg: &NodeConfig,
     stepper: &N,
     done: u64,
 ) -> Result<(), NodeError> {
+    let sample = stepper.sample(done);
+    if let Some(violation) = out_of_envelope(&sample, &cfg.guard) {
+        return Err(NodeError::Diverged {
+            step: done,
+            violation,
+            what: violation.describe(&cfg.guard),
+        });
+    }
     if done % cfg.sample_every == 0 || done == cfg.steps {
-        io.report(stepper.sample(done))?;
+        io.report(sample)?;
     }
     Ok(())
+}
+
+/// The first violation of the envelope in a sample of the node's state.
+fn out_of_envelope(sample: &Telemetry, env: &Envelope) -> Option<Violation> {
+    match sample {
+        Telemetry::Sample { state, .. } => guard::check_agent(state, env),
+        Telemetry::LeaderSample { state, .. } => guard::check_leader(state, env),
+        _ => None,
+    }
 }
 
 /// The message must be from `sender` and speak our version.

@@ -258,6 +258,7 @@ mod tests {
             stage_timeout: 10.0,
             start_timeout: 30.0,
             realtime: None,
+            guard: Default::default(),
             role: Role::Agent {
                 model: Box::new(model),
                 initial,

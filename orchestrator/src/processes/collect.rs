@@ -6,6 +6,7 @@ use super::startup::POLL;
 use super::{Failure, Ports, Session};
 use crate::outcome::Outcome;
 use attitude::engine::Snapshot;
+use attitude::guard::{self, Divergence, Envelope, Violation};
 use attitude::link::LinkStats;
 use attitude::network::AgentState;
 use attitude::reference::LeaderState;
@@ -18,8 +19,8 @@ use std::time::{Duration, Instant};
 pub(crate) enum Sampled {
     /// The leader's.
     Leader(LeaderState),
-    /// An agent's.
-    Agent(AgentState),
+    /// An agent's, with its peak torque so far.
+    Agent(AgentState, f64),
 }
 
 /// What the orchestrator knows of one node (its telemetry subscriber is the
@@ -40,6 +41,9 @@ pub(crate) struct NodeSlot {
     pub done: bool,
     /// Largest torque it reported, N·m.
     pub peak_torque: f64,
+    /// Its peak torque in the last complete snapshot, N·m (what a diverged
+    /// run reports, as the in-process engine does).
+    pub snapshot_peak_torque: f64,
     /// Its `Done` report, once it came.
     pub report: Option<Done>,
     /// It reported giving up.
@@ -57,6 +61,7 @@ impl NodeSlot {
             ready: false,
             done: false,
             peak_torque: 0.0,
+            snapshot_peak_torque: 0.0,
             report: None,
             gave_up: false,
         }
@@ -77,6 +82,11 @@ pub(crate) struct Collector {
     pub blamed: Vec<(usize, u32)>,
     /// Ids of nodes a receiver caught breaking the protocol.
     pub broke_protocol: Vec<u32>,
+    /// (node index, divergence): the nodes that left the envelope,
+    /// reported by themselves or found in their samples.
+    pub diverged: Vec<(usize, Divergence)>,
+    /// The envelope every sample is checked against.
+    pub guard: Envelope,
 }
 
 impl Collector {
@@ -88,6 +98,8 @@ impl Collector {
             links: Vec::new(),
             blamed: Vec::new(),
             broke_protocol: Vec::new(),
+            diverged: Vec::new(),
+            guard: Envelope::default(),
         }
     }
 
@@ -116,26 +128,46 @@ impl Collector {
         let t = m
             .decode()
             .map_err(|e| format!("node {}'s telemetry: {e}", m.sender))?;
-        self.take(i, t);
-        Ok(())
+        self.take(i, t)
     }
 
-    /// Books report `t` of node index `i`.
-    fn take(&mut self, i: usize, t: Telemetry) {
-        let slot = &mut self.slots[i];
+    /// Books report `t` of node index `i`; a sample is checked first
+    /// ([`Collector::check_sample`]).
+    fn take(&mut self, i: usize, t: Telemetry) -> Result<(), Failure> {
+        let env = self.guard;
         match t {
-            Telemetry::Ready => slot.ready = true,
+            Telemetry::Ready => self.slots[i].ready = true,
             Telemetry::Sample {
                 step,
                 state,
                 peak_torque,
             } => {
-                slot.peak_torque = slot.peak_torque.max(peak_torque);
-                slot.pending.push_back((step, Sampled::Agent(state)));
+                if !peak_torque.is_finite() {
+                    return Err(self.sent_garbage(i, "whose peak_torque is not finite"));
+                }
+                if self.check_sample(i, step, guard::check_agent(&state, &env))? {
+                    let slot = &mut self.slots[i];
+                    slot.peak_torque = slot.peak_torque.max(peak_torque);
+                    (slot.pending).push_back((step, Sampled::Agent(state, peak_torque)));
+                }
             }
             Telemetry::LeaderSample { step, state } => {
-                slot.pending.push_back((step, Sampled::Leader(state)));
+                if self.check_sample(i, step, guard::check_leader(&state, &env))? {
+                    self.slots[i]
+                        .pending
+                        .push_back((step, Sampled::Leader(state)));
+                }
             }
+            t => self.take_report(i, t),
+        }
+        Ok(())
+    }
+
+    /// Books a report that is not a sample.
+    fn take_report(&mut self, i: usize, t: Telemetry) {
+        let slot = &mut self.slots[i];
+        match t {
+            Telemetry::Ready | Telemetry::Sample { .. } | Telemetry::LeaderSample { .. } => {}
             Telemetry::LinkStats { from, stats } => self.links.push((from, slot.id, stats)),
             Telemetry::Done(d) => {
                 slot.done = true;
@@ -151,9 +183,69 @@ impl Collector {
                         self.broke_protocol.push(from);
                     }
                     FailReason::Other => {}
+                    FailReason::Diverged {
+                        step,
+                        quantity,
+                        value,
+                    } => self.diverged.push((
+                        i,
+                        Divergence {
+                            step,
+                            node: slot.id,
+                            violation: Violation { quantity, value },
+                        },
+                    )),
                 }
             }
         }
+    }
+
+    /// Checks a sample of node index `i` at `step` whose check against
+    /// the envelope gave `violation`: `Ok(true)` to book it; `Ok(false)`
+    /// when a value is out of the envelope or not finite (the node
+    /// diverged: booked as its divergence); an error when an attitude is
+    /// finite but not a rotation (garbage: the node broke the protocol).
+    fn check_sample(
+        &mut self,
+        i: usize,
+        step: u64,
+        violation: Option<Violation>,
+    ) -> Result<bool, Failure> {
+        if self.diverged.iter().any(|&(j, _)| j == i) {
+            return Ok(false); // a diverged node's later samples mean nothing
+        }
+        let Some(violation) = violation else {
+            return Ok(true);
+        };
+        if violation.quantity.is_attitude() && violation.value.is_finite() {
+            let q = violation.quantity.name();
+            return Err(self.sent_garbage(i, &format!("whose attitude {q} is not a rotation")));
+        }
+        let node = self.slots[i].id;
+        let divergence = Divergence {
+            step,
+            node,
+            violation,
+        };
+        self.diverged.push((i, divergence));
+        Ok(false)
+    }
+
+    /// The failure of node index `i`, which sent telemetry `what`.
+    fn sent_garbage(&self, i: usize, what: &str) -> Failure {
+        format!(
+            "{} broke the protocol: it sent telemetry {what}",
+            self.slots[i].label
+        )
+    }
+
+    /// The run's divergence: the earliest step, then the first node (the
+    /// leader, then agents in network order), as the in-process engine
+    /// finds it.
+    pub(crate) fn divergence(&self) -> Option<Divergence> {
+        (self.diverged.iter())
+            .min_by_key(|(i, d)| (d.step, *i))
+            .map(|(_, d)| *d)
     }
 
     /// Whether every node is done and every sample is in a snapshot.
@@ -161,26 +253,38 @@ impl Collector {
         (self.slots.iter()).all(|s| s.done && s.pending.is_empty())
     }
 
-    /// The next complete snapshot, if every node has sent it.
-    fn next_snapshot(&mut self) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, Failure> {
+    /// The next complete snapshot before step `before`, if every node has
+    /// sent it.
+    fn next_snapshot(
+        &mut self,
+        before: u64,
+    ) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, Failure> {
         if self.slots.iter().any(|s| s.pending.is_empty()) {
             return Ok(None);
         }
         let step = self.slots[0].pending[0].0;
+        if step >= before {
+            return Ok(None);
+        }
         if let Some(s) = self.slots.iter().find(|s| s.pending[0].0 != step) {
             return Err(format!(
                 "telemetry out of step: {} at step {}, leader at {step}",
                 s.name, s.pending[0].0
             ));
         }
-        let mut samples = (self.slots.iter_mut())
-            .map(|s| (s.name.as_str(), s.pending.pop_front().expect("non-empty").1));
+        let mut samples = (self.slots.iter_mut()).map(|s| {
+            let sample = s.pending.pop_front().expect("non-empty").1;
+            if let Sampled::Agent(_, peak) = sample {
+                s.snapshot_peak_torque = peak;
+            }
+            (s.name.as_str(), sample)
+        });
         let Some((_, Sampled::Leader(leader))) = samples.next() else {
             return Err("the leader sent an agent's sample".into());
         };
         let agents = samples
             .map(|(name, s)| match s {
-                Sampled::Agent(a) => Ok(a),
+                Sampled::Agent(a, _) => Ok(a),
                 Sampled::Leader(_) => Err(format!("{name} sent the leader's sample")),
             })
             .collect::<Result<_, _>>()?;
@@ -191,9 +295,16 @@ impl Collector {
     pub(crate) fn outcome(mut self, failure: Option<Failure>) -> Outcome {
         self.links.sort_by_key(|&(f, t, _)| (f, t));
         let agents = &self.slots[1..];
+        let diverged = self.divergence();
         Outcome {
-            peak_torques: agents.iter().map(|s| s.peak_torque).collect(),
+            peak_torques: (agents.iter())
+                .map(|s| match diverged {
+                    Some(_) => s.snapshot_peak_torque,
+                    None => s.peak_torque,
+                })
+                .collect(),
             steps: self.steps,
+            diverged,
             failure,
             pacing: (agents.iter())
                 .map(|s| {
@@ -218,12 +329,15 @@ impl Session<'_> {
     ) -> Result<(), Failure> {
         let stall = Duration::from_secs_f64(self.opts.stage_timeout * 2.0);
         let mut last_progress = Instant::now();
+        let mut diverging: Option<Instant> = None;
+        self.nodes.guard = self.net.guard;
         loop {
             self.ports.wait(POLL);
             if self.nodes.drain(&self.ports)? {
                 last_progress = Instant::now();
             }
-            while let Some((step, leader, agents)) = self.nodes.next_snapshot()? {
+            let before = self.nodes.divergence().map_or(u64::MAX, |d| d.step);
+            while let Some((step, leader, agents)) = self.nodes.next_snapshot(before)? {
                 self.nodes.steps = step;
                 let snap = Snapshot {
                     step,
@@ -233,6 +347,17 @@ impl Session<'_> {
                 if !on_sample(&snap) {
                     return Err("stopped by the results writer".into());
                 }
+            }
+            if !self.nodes.diverged.is_empty() {
+                // Every node finishes the step (a diverged node keeps its
+                // ports) and reports its own divergence: wait until they
+                // are quiet, recording the snapshots before it. The text
+                // is the divergence's (`crate::run`).
+                let since = *diverging.get_or_insert_with(Instant::now);
+                if last_progress.elapsed() >= QUIET || since.elapsed() >= SETTLE {
+                    return Err("diverged".into());
+                }
+                continue;
             }
             if self.nodes.finished() {
                 return Ok(());
@@ -247,6 +372,12 @@ impl Session<'_> {
         }
     }
 }
+
+/// After a divergence: the telemetry silent this long, every node has
+/// reported whether it diverged at that step.
+const QUIET: Duration = Duration::from_millis(300);
+/// After a divergence: the longest wait for the other nodes' reports.
+const SETTLE: Duration = Duration::from_secs(5);
 
 #[cfg(test)]
 mod tests {
@@ -287,5 +418,74 @@ mod tests {
         m.kind = 99;
         let e = c.accept(1, &m).expect_err("an unknown kind");
         assert!(e.starts_with("node 3's telemetry"), "{e}");
+    }
+
+    fn sample(step: u64, w1: f64, r_scale: f64) -> TelemetryMsg {
+        let state = AgentState {
+            r: nalgebra::Matrix3::identity() * r_scale,
+            w: nalgebra::Vector3::new(0.0, w1, 0.0),
+            r_hat: nalgebra::Matrix3::identity(),
+            w_hat: nalgebra::Vector3::zeros(),
+            s_hat: nalgebra::Vector3::zeros(),
+        };
+        let t = Telemetry::Sample {
+            step,
+            state,
+            peak_torque: 1.0,
+        };
+        TelemetryMsg::encode(3, &t)
+    }
+
+    #[test]
+    fn a_nan_sample_is_the_nodes_divergence_and_is_not_booked() {
+        let mut c = two_nodes();
+        c.accept(1, &sample(0, 1.0, 1.0)).expect("a sane sample");
+        c.accept(1, &sample(10, f64::NAN, 1.0))
+            .expect("a divergence, not an error");
+        assert_eq!(c.slots[1].pending.len(), 1);
+        let d = c.divergence().expect("diverged");
+        assert_eq!((d.step, d.node), (10, 3));
+        assert_eq!(d.violation.quantity, attitude::guard::Quantity::Omega);
+        assert!(d.violation.value.is_nan());
+        // Later samples of a diverged node are not booked either.
+        c.accept(1, &sample(20, 1.0, 1.0)).expect("ignored");
+        assert_eq!(c.slots[1].pending.len(), 1);
+    }
+
+    #[test]
+    fn a_sample_whose_attitude_is_not_a_rotation_fails_naming_the_node() {
+        let mut c = two_nodes();
+        let e = c.accept(1, &sample(0, 1.0, 2.0)).expect_err("2·I");
+        assert_eq!(
+            e,
+            "agent-3 (plug-in `x`) broke the protocol: it sent telemetry whose attitude r is not a rotation"
+        );
+        assert!(c.diverged.is_empty() && c.slots[1].pending.is_empty());
+    }
+
+    #[test]
+    fn the_earliest_divergence_wins_then_the_first_node() {
+        let mut c = two_nodes();
+        let diverged = |step, quantity| {
+            Telemetry::Failed(FailReason::Diverged {
+                step,
+                quantity,
+                value: 2e4,
+            })
+        };
+        use attitude::guard::Quantity;
+        c.accept(
+            1,
+            &TelemetryMsg::encode(3, &diverged(7, Quantity::SigmaHat)),
+        )
+        .expect("booked");
+        c.accept(0, &TelemetryMsg::encode(0, &diverged(7, Quantity::Omega0)))
+            .expect("booked");
+        assert_eq!(c.divergence().map(|d| d.node), Some(0));
+        c.accept(1, &TelemetryMsg::encode(3, &diverged(6, Quantity::R)))
+            .expect("booked");
+        let d = c.divergence().expect("diverged");
+        assert_eq!((d.step, d.node, d.violation.quantity), (6, 3, Quantity::R));
+        assert!(c.slots[1].gave_up);
     }
 }

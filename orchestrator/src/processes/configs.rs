@@ -76,6 +76,7 @@ pub fn node_configs(
         stage_timeout: opts.stage_timeout,
         start_timeout: opts.start_timeout,
         realtime: opts.realtime,
+        guard: net.guard,
         role,
     };
     let mut out = vec![base(

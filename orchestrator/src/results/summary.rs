@@ -78,6 +78,9 @@ pub struct Summary {
     pub complete: bool,
     /// Why not, if not.
     pub incomplete_reason: Option<String>,
+    /// The state that left the envelope, if the run diverged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diverged: Option<Diverged>,
     /// Integrator step, s.
     pub dt: f64,
     /// Requested horizon, s.
@@ -101,6 +104,36 @@ pub struct Summary {
     /// Processes engine: what every node that finished reported (empty in-process).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub nodes: Vec<NodeSummary>,
+}
+
+/// Where a run diverged: the first state outside the envelope
+/// (`attitude::guard`), the same in both engines.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Diverged {
+    /// Simulated time of the state, s.
+    pub t: f64,
+    /// `leader` or `agent-<id>`.
+    pub node: String,
+    /// `r`, `omega`, `r_hat`, `omega_hat`, `sigma_hat` (agents), `r0`,
+    /// `omega0`, `sigma0` (the leader).
+    pub quantity: String,
+    /// Its value: a norm, a non-finite entry (NaN written as `null`), or an
+    /// attitude's orthogonality defect.
+    #[serde(deserialize_with = "f64_or_nan")]
+    pub value: f64,
+}
+
+impl Diverged {
+    /// The summary of divergence `d` in a run of step `dt`.
+    #[must_use]
+    pub fn of(d: &attitude::guard::Divergence, dt: f64) -> Self {
+        Self {
+            t: d.step as f64 * dt,
+            node: d.node_name(),
+            quantity: d.violation.quantity.name().into(),
+            value: d.violation.value,
+        }
+    }
 }
 
 /// One node process of a processes-engine run, from its `Done` report.

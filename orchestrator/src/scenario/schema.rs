@@ -34,6 +34,33 @@ pub struct Scenario {
     /// Communication impairments (default: an ideal network).
     #[serde(default)]
     pub network: NetworkSpec,
+    /// The envelope of a sane state (default: `attitude::guard::Envelope::default`).
+    #[serde(default, skip_serializing_if = "GuardSpec::is_unset")]
+    pub guard: GuardSpec,
+}
+
+/// `[guard]`: the largest norms a node's state may reach before the run
+/// stops as diverged (unset fields take the defaults, 1e4).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GuardSpec {
+    /// Largest `‖ωᵢ‖`, rad/s.
+    #[serde(default)]
+    pub omega: Option<f64>,
+    /// Largest `‖ω̂ᵢ‖` and `‖ω₀‖`, rad/s.
+    #[serde(default)]
+    pub omega_hat: Option<f64>,
+    /// Largest `‖σ̂ᵢ‖` and `‖σ₀‖`, rad/s².
+    #[serde(default)]
+    pub sigma_hat: Option<f64>,
+}
+
+impl GuardSpec {
+    /// Whether no bound is set (then the table is not written).
+    #[must_use]
+    pub fn is_unset(&self) -> bool {
+        self.omega.is_none() && self.omega_hat.is_none() && self.sigma_hat.is_none()
+    }
 }
 
 /// `[network]`: impairments of every link (defaults) and per directed link

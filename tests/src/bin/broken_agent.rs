@@ -11,6 +11,8 @@
 //! | `skip-step` | at the first exchange from step 3 on, stamps its state (n + 1, s) where (n, s) was due (once) | rule `in-order`; in a run, its receivers' protocol check |
 //! | `never-stops` | does everything right, then ignores `Stop` and waits until killed (or until its parent is gone) | rule `stops` |
 //! | `nan` | at the first exchange from step 5 on, publishes ω with a NaN | rule `valid-states`; in a run, its receivers refuse it and count it |
+//! | `nan-telemetry` | from step 10 on, reports samples whose ω is NaN (its state, what it publishes, stays correct) | rule `telemetry`; in a run, the orchestrator: the node diverged (exit 3) |
+//! | `bad-telemetry` | from step 10 on, reports samples whose attitude is 2·R (not a rotation) | rule `telemetry`; in a run, the orchestrator: the node broke the protocol |
 //!
 //! Any other value exits 2. Faults need lockstep (`realtime` = null).
 
@@ -21,7 +23,7 @@ use iceoryx2::prelude::*;
 use iceoryx2::service::builder::publish_subscribe::{
     PublishSubscribeOpenError as Open, PublishSubscribeOpenOrCreateError as OpenOrCreate,
 };
-use msgs::{ControlCommand, StateMsg, config::NodeConfig, names};
+use msgs::{ControlCommand, StateMsg, Telemetry, config::NodeConfig, names};
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
@@ -34,6 +36,9 @@ struct Fault {
     at: Option<Slot>,
 }
 
+/// Samples from this step on are garbled (`nan-telemetry`, `bad-telemetry`).
+const GARBLED_FROM: u64 = 10;
+
 impl Hooks for Fault {
     fn before_publish(&mut self, slot: Slot, msg: &mut StateMsg) -> Override {
         if self.at == Some(slot) {
@@ -41,6 +46,17 @@ impl Hooks for Fault {
             match self.kind.as_str() {
                 "skip-step" => msg.step += 1,
                 _ => msg.w[0] = f64::NAN,
+            }
+        }
+        Override::Run
+    }
+
+    fn before_report(&mut self, t: &mut Telemetry) -> Override {
+        if let Telemetry::Sample { step, state, .. } = t {
+            match self.kind.as_str() {
+                "nan-telemetry" if *step >= GARBLED_FROM => state.w[1] = f64::NAN,
+                "bad-telemetry" if *step >= GARBLED_FROM => state.r *= 2.0,
+                _ => {}
             }
         }
         Override::Run
@@ -105,8 +121,11 @@ fn wrong_type<S: Service>(node: &Node<S>, cfg: &NodeConfig) -> Result<(), String
 
 fn main() -> ExitCode {
     let kind = std::env::var("ATTSYNC_FAULT").unwrap_or_default();
-    if !["", "wrong-type", "skip-step", "never-stops", "nan"].contains(&kind.as_str()) {
-        let expected = "expected wrong-type, skip-step, never-stops or nan";
+    let kinds = ["", "wrong-type", "skip-step", "never-stops", "nan"];
+    let telemetry = ["nan-telemetry", "bad-telemetry"];
+    if !kinds.iter().chain(&telemetry).any(|k| *k == kind) {
+        let expected =
+            "expected wrong-type, skip-step, never-stops, nan, nan-telemetry or bad-telemetry";
         eprintln!("broken_agent: ATTSYNC_FAULT={kind:?}: {expected}");
         return ExitCode::from(2);
     }

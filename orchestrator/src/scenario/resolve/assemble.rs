@@ -5,6 +5,7 @@ use super::agents::Body;
 use super::graph::{Edges, LeaderLinks};
 use super::leader::Leader;
 use super::simulation::Timing;
+use attitude::guard::Envelope;
 use attitude::link::LinkModel;
 use attitude::network::{AgentModel, AgentSpec, Neighbour, Network, Scheme};
 use attitude::reference::LeaderState;
@@ -17,6 +18,7 @@ pub(super) struct Parts {
     pub(super) leader: Leader,
     pub(super) bodies: BTreeMap<u32, Body>,
     pub(super) impaired: BTreeMap<(u32, u32), LinkModel>,
+    pub(super) guard: Envelope,
 }
 
 /// The network of `parts` over `edges` and `links`.
@@ -30,6 +32,7 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
         leader,
         bodies,
         impaired,
+        guard,
     } = parts;
     let scheme = scheme.expect("no errors");
     let p = leader.p;
@@ -67,6 +70,7 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
         steps: time.steps.expect("no errors"),
         coupling: time.coupling.expect("no errors"),
         sample_every: time.sample_every.expect("no errors"),
+        guard,
     }
 }
 

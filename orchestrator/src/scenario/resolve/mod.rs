@@ -14,6 +14,7 @@
 //! - `checks` — reachability from the leader, spectrum (sparse: extremes
 //!   and count; every eigenvalue only for small N), Appendix D;
 //! - `network` — `[network]`, `[[network.link]]`;
+//! - `guard` — `[guard]`, the envelope of a sane state;
 //! - `assemble` — the [`Network`] from the parts, once there are no errors;
 //! - `stiffness` — on the assembled network: `simulation.dt` against RK4's
 //!   largest stable step ([`stable_dt`], [`REFUSE_FACTOR`], [`WARN_FROM`]).
@@ -23,6 +24,7 @@ mod assemble;
 mod checks;
 mod ctx;
 mod graph;
+mod guard;
 mod leader;
 mod network;
 mod rotation;
@@ -107,6 +109,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     } else {
         BTreeMap::new()
     };
+    let envelope = guard::guard(&mut c, &s.guard);
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
@@ -116,6 +119,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         leader,
         bodies,
         impaired,
+        guard: envelope,
     };
     let network = assemble::network(parts, &edges, &links);
     // The extremes of Ξ + LLᵀ are all the estimate needs (none without agents).
