@@ -125,6 +125,9 @@ pub struct Agent {
     gains: Vec<Matrix3<f64>>,
     state: AgentState,
     step: Rkmk4<2, 3>,
+    /// `step`'s current stage state, computed once per stage (published
+    /// and evaluated at).
+    stage_x: AgentState,
     dt: f64,
     held_nbrs: Vec<Exchanged>,
     held_leader: Option<Exchanged>,
@@ -157,6 +160,7 @@ impl Agent {
             rejected,
             state: initial,
             step: Rkmk4::new(to_lie(&initial), dt),
+            stage_x: initial,
             dt,
             held_nbrs,
             held_leader,
@@ -187,7 +191,7 @@ impl Agent {
     /// What the agent publishes at the current stage.
     #[must_use]
     pub fn stage_exchange(&self) -> Exchanged {
-        exchanged_of(&self.model.scheme, &from_lie(&self.step.stage_state()))
+        exchanged_of(&self.model.scheme, &self.stage_x)
     }
 
     /// Stores the value received from the `k`-th neighbour (order of `model.neighbours`).
@@ -257,11 +261,10 @@ impl Agent {
                 }
             }
         }
-        let x = from_lie(&self.step.stage_state());
         let (d, tau) = agent_field(
             &self.model,
             &self.gains,
-            &x,
+            &self.stage_x,
             &self.held_nbrs,
             self.held_leader.as_ref(),
         );
@@ -272,10 +275,14 @@ impl Agent {
             Some(next) => {
                 self.state = from_lie(&next);
                 self.step = Rkmk4::new(next, self.dt);
+                self.stage_x = self.state;
                 self.n += 1;
                 true
             }
-            None => false,
+            None => {
+                self.stage_x = from_lie(&self.step.stage_state());
+                false
+            }
         }
     }
 }

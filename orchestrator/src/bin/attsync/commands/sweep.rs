@@ -19,9 +19,12 @@ pub struct Sweep {
     /// Values, comma-separated (TOML literals).
     #[arg(long, value_delimiter = ',', required = true)]
     pub values: Vec<String>,
-    /// Runs at once [default: number of cores].
+    /// Runs at once [default: number of cores, or cores / --threads].
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// In-process engine: threads per run (≥ 1) [default: cores / jobs, at least 1].
+    #[arg(long)]
+    pub threads: Option<usize>,
     #[command(flatten)]
     pub engine: EngineArgs,
     /// Sweep directory [default: results/<scenario name>-sweep-<param>].
@@ -43,17 +46,19 @@ pub struct Sweep {
 
 /// Runs the sweep and prints its table.
 pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
+    let (jobs, threads) = sweep::jobs_and_threads(a.jobs, a.threads);
     let mut o = SweepOptions {
         scenario: a.scenario.scenario.clone(),
         param: a.param,
         values: a.values,
-        jobs: a.jobs.unwrap_or_else(sweep::default_jobs),
+        jobs,
         set: a.scenario.overrides.set.clone(),
         run: RunOptions {
             engine: a.engine.engine,
             out: a.out.clone().unwrap_or_default(),
             processes: a.engine.process_options(None),
             progress: false,
+            threads,
         },
         tolerance: a.tolerance,
         find_margin: a.find_margin.then_some(Bisection {
