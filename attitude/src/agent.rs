@@ -199,7 +199,14 @@ impl Agent {
     /// An untrusted value ([`Exchanged::trust`]) is refused and counted; the
     /// agent keeps what it had, in every engine alike.
     pub fn receive_neighbour(&mut self, k: usize, x: Exchanged) {
-        if x.trust().is_err() {
+        self.receive_neighbour_judged(k, x, x.trust().is_ok());
+    }
+
+    /// [`Self::receive_neighbour`] with `trusted = x.trust().is_ok()`
+    /// already evaluated (once per sender, by an engine that hands one
+    /// value to many receivers).
+    pub fn receive_neighbour_judged(&mut self, k: usize, x: Exchanged, trusted: bool) {
+        if !trusted {
             self.rejected[k] += 1;
             return;
         }
@@ -212,8 +219,15 @@ impl Agent {
     /// Stores the value received from the leader (ignored if not connected;
     /// refused and counted if untrusted).
     pub fn receive_leader(&mut self, x: Exchanged) {
+        let trusted = self.held_leader.is_none() || x.trust().is_ok();
+        self.receive_leader_judged(x, trusted);
+    }
+
+    /// [`Self::receive_leader`] with `trusted = x.trust().is_ok()` already
+    /// evaluated (see [`Self::receive_neighbour_judged`]).
+    pub fn receive_leader_judged(&mut self, x: Exchanged, trusted: bool) {
         let k = self.model.neighbours.len();
-        if self.held_leader.is_some() && x.trust().is_err() {
+        if self.held_leader.is_some() && !trusted {
             self.rejected[k] += 1;
             return;
         }

@@ -19,6 +19,7 @@ mod crew;
 
 use crate::agent::Agent;
 use crate::network::{AgentState, Network};
+use board::Judged;
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::Schedule;
 use crew::{Board, Plan, Share};
@@ -51,6 +52,9 @@ pub struct InProcess {
     states: Vec<AgentState>,
     /// Threads [`Self::run`] uses (1: the calling thread only).
     threads: usize,
+    /// The one-thread step's published values and their verdicts
+    /// ([`crate::network::Exchanged::trust`], judged once per sender).
+    published: Vec<Judged>,
 }
 
 impl InProcess {
@@ -73,6 +77,7 @@ impl InProcess {
             step: 0,
             states,
             threads: 1,
+            published: Vec::new(),
         }
     }
 
@@ -123,17 +128,18 @@ impl InProcess {
     /// Advances every node by one step (four stages, exchanging as the
     /// coupling says), on the calling thread.
     pub fn step(&mut self) {
-        let mut published = Vec::with_capacity(self.agents.len());
+        let published = &mut self.published;
         for slot in Schedule::new(self.net.coupling, self.net.steps).stages(self.step) {
             if slot.exchange {
-                let from_leader = self.leader.stage_exchange();
+                let from_leader = Judged::of(self.leader.stage_exchange());
                 published.clear();
-                published.extend(self.agents.iter().map(Agent::stage_exchange));
+                published.extend(self.agents.iter().map(|a| Judged::of(a.stage_exchange())));
                 for (agent, nbrs) in self.agents.iter_mut().zip(&self.nbr_index) {
                     for (k, &j) in nbrs.iter().enumerate() {
-                        agent.receive_neighbour(k, published[j]);
+                        let Judged(x, trusted) = published[j];
+                        agent.receive_neighbour_judged(k, x, trusted);
                     }
-                    agent.receive_leader(from_leader);
+                    agent.receive_leader_judged(from_leader.0, from_leader.1);
                 }
             }
             self.leader.advance();
@@ -176,6 +182,7 @@ impl InProcess {
             step,
             states,
             threads,
+            ..
         } = self;
         let board = Board::new(agents.len(), *threads);
         let plan = Plan {

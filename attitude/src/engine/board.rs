@@ -81,6 +81,37 @@ impl Words<EXCHANGED> for Exchanged {
     }
 }
 
+/// A published value and whether receivers may use it
+/// ([`Exchanged::trust`], judged once by the sender's thread).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Judged(pub Exchanged, pub bool);
+
+impl Judged {
+    /// `x` with its verdict.
+    #[must_use]
+    pub fn of(x: Exchanged) -> Self {
+        let trusted = x.trust().is_ok();
+        Self(x, trusted)
+    }
+}
+
+/// Words of a [`Judged`]: the value, then 1 (trusted) or 0.
+pub const JUDGED: usize = EXCHANGED + 1;
+
+impl Words<JUDGED> for Judged {
+    fn to_words(&self) -> [f64; JUDGED] {
+        let mut w = [0.0; JUDGED];
+        put(&mut w, 0, &self.0.to_words());
+        w[EXCHANGED] = f64::from(u8::from(self.1));
+        w
+    }
+
+    fn from_words(w: &[f64; JUDGED]) -> Self {
+        let x: &[f64; EXCHANGED] = w[..EXCHANGED].try_into().expect("15 words");
+        Self(Exchanged::from_words(x), w[EXCHANGED] == 1.0)
+    }
+}
+
 /// Words of an [`AgentState`].
 pub const AGENT_STATE: usize = 27;
 

@@ -14,9 +14,9 @@
 //! for any number of threads.
 
 use super::barrier::SpinBarrier;
-use super::board::{AGENT_STATE, EXCHANGED, Slot, slots};
+use super::board::{AGENT_STATE, JUDGED, Judged, Slot, slots};
 use crate::agent::Agent;
-use crate::network::{AgentState, Exchanged};
+use crate::network::AgentState;
 use crate::reference::Leader;
 use crate::schedule::Schedule;
 use std::sync::atomic::{AtomicBool, Ordering::SeqCst};
@@ -26,7 +26,7 @@ use std::sync::atomic::{AtomicBool, Ordering::SeqCst};
 pub(super) struct Board {
     /// Published stage states, two buffers used in turn: agents in network
     /// order, then the leader.
-    published: [Vec<Slot<EXCHANGED>>; 2],
+    published: [Vec<Slot<JUDGED>>; 2],
     /// Every agent's state at the end of the last step.
     states: Vec<Slot<AGENT_STATE>>,
     barrier: SpinBarrier,
@@ -113,19 +113,20 @@ impl<'a> Share<'a> {
         self.parity ^= 1;
         let leader_slot = &buffer[buffer.len() - 1];
         if let Some(l) = leader {
-            leader_slot.store(&l.stage_exchange());
+            leader_slot.store(&Judged::of(l.stage_exchange()));
         }
         for (slot, agent) in buffer[self.first..].iter().zip(self.agents.iter()) {
-            slot.store(&agent.stage_exchange());
+            slot.store(&Judged::of(agent.stage_exchange()));
         }
         board.barrier.wait();
-        let from_leader: Exchanged = leader_slot.load();
+        let Judged(from_leader, leader_trusted) = leader_slot.load();
         let nbrs = &plan.nbr_index[self.first..];
         for (agent, nbrs) in self.agents.iter_mut().zip(nbrs) {
             for (k, &j) in nbrs.iter().enumerate() {
-                agent.receive_neighbour(k, buffer[j].load());
+                let Judged(x, trusted) = buffer[j].load();
+                agent.receive_neighbour_judged(k, x, trusted);
             }
-            agent.receive_leader(from_leader);
+            agent.receive_leader_judged(from_leader, leader_trusted);
         }
     }
 }
