@@ -3,15 +3,19 @@
 //! The parallel engine meets at a barrier once per exchange and twice per
 //! step. `std::sync::Barrier` takes its mutex on every wait (about a
 //! microsecond each on this machine); here an arrival is one atomic add
-//! and a waiter spins for up to [`SPINS`] polls of the generation before
-//! it sleeps on a condition variable (so a machine shared with other work
-//! is not burnt by idle spinning).
+//! and a waiter spins for up to [`SPINS`] polls of the generation, then
+//! yields its core up to [`YIELDS`] times (a late thread may be waiting for
+//! it), then sleeps on a condition variable (so a machine shared with other
+//! work is not burnt by idle spinning).
 
 use std::sync::atomic::{AtomicUsize, Ordering::SeqCst};
 use std::sync::{Condvar, Mutex, PoisonError};
 
-/// Polls of the generation before a waiter sleeps (a few µs).
-pub const SPINS: u32 = 4_000;
+/// Polls of the generation before a waiter yields (about a µs).
+pub const SPINS: u32 = 1_000;
+
+/// Yields before a waiter sleeps.
+pub const YIELDS: u32 = 16;
 
 /// A reusable barrier for a fixed number of threads.
 #[derive(Debug)]
@@ -58,6 +62,12 @@ impl SpinBarrier {
                 return;
             }
             std::hint::spin_loop();
+        }
+        for _ in 0..YIELDS {
+            if self.generation.load(SeqCst) != generation {
+                return;
+            }
+            std::thread::yield_now();
         }
         let mut held = self.lock.lock().unwrap_or_else(PoisonError::into_inner);
         self.sleepers.fetch_add(1, SeqCst);
