@@ -19,9 +19,9 @@ mod crew;
 
 use crate::agent::Agent;
 use crate::network::{AgentState, Network};
-use board::Judged;
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::Schedule;
+use board::Judged;
 use crew::{Board, Plan, Share};
 
 /// Fewest agents per thread [`InProcess::with_threads`] gives a thread:

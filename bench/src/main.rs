@@ -94,7 +94,11 @@ enum Cmd {
     /// agents and threads, per scheme (networks built in memory; a Markdown table).
     Scale {
         /// Numbers of agents, comma-separated.
-        #[arg(long, value_delimiter = ',', default_value = "10,100,1000,10000,100000")]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "10,100,1000,10000,100000"
+        )]
         agents: Vec<u32>,
         /// Thread counts, comma-separated.
         #[arg(long, value_delimiter = ',', default_value = "1,2")]
@@ -278,7 +282,12 @@ fn scale_table(
         for &n in agents.iter().filter(|&&n| n > 0) {
             for &t in threads.iter().filter(|&&t| t > 0) {
                 let f = scale::measure(s, n, t, exact, budget);
-                eprintln!("{} N={n} threads={t} ({}): {:.3e} agent-steps/s", s.name(), f.threads, f.agent_steps_per_s());
+                eprintln!(
+                    "{} N={n} threads={t} ({}): {:.3e} agent-steps/s",
+                    s.name(),
+                    f.threads,
+                    f.agent_steps_per_s()
+                );
                 figures.push(f);
             }
         }

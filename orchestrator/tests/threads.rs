@@ -26,7 +26,11 @@ fn run_on(net: &attitude::network::Network, threads: usize) -> Run {
     let mut samples = Vec::new();
     engine.run(|snap| {
         let bits = (snap.agents.iter())
-            .flat_map(|a| (a.r.iter().chain(&a.w).chain(&a.r_hat)).chain(&a.w_hat).chain(&a.s_hat))
+            .flat_map(|a| {
+                (a.r.iter().chain(&a.w).chain(&a.r_hat))
+                    .chain(&a.w_hat)
+                    .chain(&a.s_hat)
+            })
             .chain(snap.leader.r0.iter().chain(&snap.leader.w0))
             .map(|v| v.to_bits())
             .collect();
@@ -35,7 +39,11 @@ fn run_on(net: &attitude::network::Network, threads: usize) -> Run {
     });
     let agents = engine.agents();
     let peaks = agents.iter().map(|a| a.peak_torque().to_bits()).collect();
-    (samples, peaks, agents.iter().map(|a| a.link_stats()).collect())
+    (
+        samples,
+        peaks,
+        agents.iter().map(|a| a.link_stats()).collect(),
+    )
 }
 
 #[test]
@@ -49,7 +57,10 @@ fn paper_scenarios_are_bit_identical_on_1_2_3_and_7_threads() {
         assert_eq!(one.0.len(), 101, "{name}: samples every 10 ms over 1 s");
         assert_ne!(one.0[0].1, one.0[100].1, "{name}: the network moved");
         for threads in [2, 3, 7] {
-            assert!(run_on(net, threads) == one, "{name}: {threads} threads differ");
+            assert!(
+                run_on(net, threads) == one,
+                "{name}: {threads} threads differ"
+            );
         }
     }
 }
@@ -75,17 +86,44 @@ fn a_300_agent_tree_gives_byte_identical_results_for_any_thread_count() {
     let made = attsync(
         dir,
         &[
-            "gen", "tree", "--agents", "300", "--leader-links", "3", "--seed", "1", "--scheme",
-            "observerless", "--duration", "0.3", "--out", "tree.toml",
+            "gen",
+            "tree",
+            "--agents",
+            "300",
+            "--leader-links",
+            "3",
+            "--seed",
+            "1",
+            "--scheme",
+            "observerless",
+            "--duration",
+            "0.3",
+            "--out",
+            "tree.toml",
         ],
     );
-    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
     let mut first: Option<(Vec<u8>, Vec<u8>)> = None;
     for (threads, used) in [("1", 1), ("2", 2), ("3", 3), ("7", 4)] {
         let out = format!("out-{threads}");
-        let args = ["run", "tree.toml", "--engine", "in-process", "--quiet", "--threads"];
+        let args = [
+            "run",
+            "tree.toml",
+            "--engine",
+            "in-process",
+            "--quiet",
+            "--threads",
+        ];
         let run = attsync(dir, &[&args[..], &[threads, "--out", &out]].concat());
-        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         let out = dir.join(out);
         assert_eq!(summary_threads(&out), serde_json::json!(used));
         let files = (
@@ -103,10 +141,31 @@ fn a_300_agent_tree_gives_byte_identical_results_for_any_thread_count() {
 #[test]
 fn zero_threads_are_refused_naming_the_option() {
     let tmp = tempfile::tempdir().expect("tempdir");
-    let paper = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper/timevarying.toml");
+    let paper = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenarios/paper/timevarying.toml"
+    );
     for cmd in [
-        vec!["run", paper, "--engine", "in-process", "--threads", "0", "--out", "o"],
-        vec!["sweep", paper, "--param", "simulation.dt", "--values", "0.001", "--threads", "0"],
+        vec![
+            "run",
+            paper,
+            "--engine",
+            "in-process",
+            "--threads",
+            "0",
+            "--out",
+            "o",
+        ],
+        vec![
+            "sweep",
+            paper,
+            "--param",
+            "simulation.dt",
+            "--values",
+            "0.001",
+            "--threads",
+            "0",
+        ],
     ] {
         let out = attsync(tmp.path(), &cmd);
         assert_eq!(out.status.code(), Some(2), "{cmd:?}");

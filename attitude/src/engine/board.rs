@@ -38,7 +38,9 @@ impl<const N: usize> Slot<N> {
     /// The value stored last (before the last barrier).
     #[must_use]
     pub fn load<T: Words<N>>(&self) -> T {
-        T::from_words(&std::array::from_fn(|i| f64::from_bits(self.0[i].load(Relaxed))))
+        T::from_words(&std::array::from_fn(|i| {
+            f64::from_bits(self.0[i].load(Relaxed))
+        }))
     }
 }
 
@@ -151,7 +153,10 @@ mod tests {
         let slot = Slot::<EXCHANGED>::default();
         slot.store(&x);
         let y: Exchanged = slot.load();
-        assert_eq!(x.to_words().map(f64::to_bits), y.to_words().map(f64::to_bits));
+        assert_eq!(
+            x.to_words().map(f64::to_bits),
+            y.to_words().map(f64::to_bits)
+        );
         let s = AgentState {
             r: x.r,
             w: x.w,
@@ -162,6 +167,9 @@ mod tests {
         let slot = Slot::<AGENT_STATE>::default();
         slot.store(&s);
         let t: AgentState = slot.load();
-        assert_eq!(s.to_words().map(f64::to_bits), t.to_words().map(f64::to_bits));
+        assert_eq!(
+            s.to_words().map(f64::to_bits),
+            t.to_words().map(f64::to_bits)
+        );
     }
 }

@@ -88,7 +88,13 @@ impl<'a> Share<'a> {
     /// Steps this share's agents (and the leader, on the thread that has
     /// it) through step `n`, then puts their states on the board and
     /// waits for every thread (the step's end).
-    pub(super) fn step(&mut self, board: &Board, plan: Plan<'_>, n: u64, leader: Option<&mut Leader>) {
+    pub(super) fn step(
+        &mut self,
+        board: &Board,
+        plan: Plan<'_>,
+        n: u64,
+        leader: Option<&mut Leader>,
+    ) {
         let mut leader = leader;
         for slot in plan.schedule.stages(n) {
             if slot.exchange {

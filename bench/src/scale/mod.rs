@@ -67,7 +67,10 @@ pub fn measure(scheme: SchemeArg, agents: u32, threads: usize, exact: bool, budg
     let mut finite = true;
     engine.run(|snap| {
         if snap.step == net.steps {
-            finite = snap.agents.iter().all(|a| a.r.iter().chain(&a.w).all(|v| v.is_finite()));
+            finite = snap
+                .agents
+                .iter()
+                .all(|a| a.r.iter().chain(&a.w).all(|v| v.is_finite()));
         }
         true
     });
@@ -96,7 +99,11 @@ pub fn table(figures: &[Figure], threads: &[usize]) -> String {
     let mut rows: Vec<(SchemeArg, u32)> = figures.iter().map(|f| (f.scheme, f.agents)).collect();
     rows.dedup();
     for (scheme, n) in rows {
-        let of = |t: usize| figures.iter().find(|f| (f.scheme, f.agents, f.asked) == (scheme, n, t));
+        let of = |t: usize| {
+            figures
+                .iter()
+                .find(|f| (f.scheme, f.agents, f.asked) == (scheme, n, t))
+        };
         let steps = of(threads[0]).map_or(0, |f| f.steps);
         let _ = write!(s, "\n| {} | {n} | {steps} |", scheme.name());
         for &t in threads {
@@ -122,7 +129,13 @@ mod tests {
         let mut out = Vec::new();
         InProcess::new(net).with_exact_threads(threads).run(|snap| {
             let bits = (snap.agents.iter())
-                .flat_map(|a| a.r.iter().chain(&a.w).chain(&a.r_hat).chain(&a.w_hat).chain(&a.s_hat))
+                .flat_map(|a| {
+                    a.r.iter()
+                        .chain(&a.w)
+                        .chain(&a.r_hat)
+                        .chain(&a.w_hat)
+                        .chain(&a.s_hat)
+                })
                 .map(|v| v.to_bits())
                 .collect();
             out.push((snap.step, bits));

@@ -11,9 +11,7 @@
 
 use attitude::body::Inertia;
 use attitude::control::ControlGains;
-use attitude::network::{
-    AgentModel, AgentSpec, AgentState, Coupling, Neighbour, Network, Scheme,
-};
+use attitude::network::{AgentModel, AgentSpec, AgentState, Coupling, Neighbour, Network, Scheme};
 use attitude::observer::ObserverGains;
 use attitude::reference::LeaderState;
 use attitude::so3::rot;
@@ -53,7 +51,10 @@ impl SchemeArg {
             k_w: 14.0,
             k_sigma: 12.0,
         };
-        let control = ControlGains { k_r: 8.0, k_w: 13.0 };
+        let control = ControlGains {
+            k_r: 8.0,
+            k_w: 13.0,
+        };
         match self {
             SchemeArg::ObserverTimeVarying => Scheme::ObserverTimeVarying { observer, control },
             SchemeArg::ObserverConstant => Scheme::ObserverConstant { observer, control },
