@@ -125,6 +125,9 @@ pub struct Agent {
     gains: Vec<Matrix3<f64>>,
     state: AgentState,
     step: Rkmk4<2, 3>,
+    /// `step`'s current stage state, computed once per stage (published
+    /// and evaluated at).
+    stage_x: AgentState,
     dt: f64,
     held_nbrs: Vec<Exchanged>,
     held_leader: Option<Exchanged>,
@@ -157,6 +160,7 @@ impl Agent {
             rejected,
             state: initial,
             step: Rkmk4::new(to_lie(&initial), dt),
+            stage_x: initial,
             dt,
             held_nbrs,
             held_leader,
@@ -187,7 +191,7 @@ impl Agent {
     /// What the agent publishes at the current stage.
     #[must_use]
     pub fn stage_exchange(&self) -> Exchanged {
-        exchanged_of(&self.model.scheme, &from_lie(&self.step.stage_state()))
+        exchanged_of(&self.model.scheme, &self.stage_x)
     }
 
     /// Stores the value received from the `k`-th neighbour (order of `model.neighbours`).
@@ -195,7 +199,14 @@ impl Agent {
     /// An untrusted value ([`Exchanged::trust`]) is refused and counted; the
     /// agent keeps what it had, in every engine alike.
     pub fn receive_neighbour(&mut self, k: usize, x: Exchanged) {
-        if x.trust().is_err() {
+        self.receive_neighbour_judged(k, x, x.trust().is_ok());
+    }
+
+    /// [`Self::receive_neighbour`] with `trusted = x.trust().is_ok()`
+    /// already evaluated (once per sender, by an engine that hands one
+    /// value to many receivers).
+    pub fn receive_neighbour_judged(&mut self, k: usize, x: Exchanged, trusted: bool) {
+        if !trusted {
             self.rejected[k] += 1;
             return;
         }
@@ -208,8 +219,15 @@ impl Agent {
     /// Stores the value received from the leader (ignored if not connected;
     /// refused and counted if untrusted).
     pub fn receive_leader(&mut self, x: Exchanged) {
+        let trusted = self.held_leader.is_none() || x.trust().is_ok();
+        self.receive_leader_judged(x, trusted);
+    }
+
+    /// [`Self::receive_leader`] with `trusted = x.trust().is_ok()` already
+    /// evaluated (see [`Self::receive_neighbour_judged`]).
+    pub fn receive_leader_judged(&mut self, x: Exchanged, trusted: bool) {
         let k = self.model.neighbours.len();
-        if self.held_leader.is_some() && x.trust().is_err() {
+        if self.held_leader.is_some() && !trusted {
             self.rejected[k] += 1;
             return;
         }
@@ -257,11 +275,10 @@ impl Agent {
                 }
             }
         }
-        let x = from_lie(&self.step.stage_state());
         let (d, tau) = agent_field(
             &self.model,
             &self.gains,
-            &x,
+            &self.stage_x,
             &self.held_nbrs,
             self.held_leader.as_ref(),
         );
@@ -272,10 +289,14 @@ impl Agent {
             Some(next) => {
                 self.state = from_lie(&next);
                 self.step = Rkmk4::new(next, self.dt);
+                self.stage_x = self.state;
                 self.n += 1;
                 true
             }
-            None => false,
+            None => {
+                self.stage_x = from_lie(&self.step.stage_state());
+                false
+            }
         }
     }
 }

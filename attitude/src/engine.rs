@@ -1,14 +1,34 @@
-//! The in-process engine: every node in one loop, in lockstep.
+//! The in-process engine: every node in one loop, in lockstep, on one
+//! thread or several.
 //!
 //! It runs exactly the protocol of [`crate::agent`] that the
 //! process-per-agent engine runs over shared memory, so both produce
-//! bit-identical trajectories.
+//! bit-identical trajectories. On several threads ([`InProcess::with_threads`])
+//! each thread steps a contiguous chunk of the agents and the exchanges are
+//! barriers; an agent's arithmetic depends only on its own state and the
+//! values it holds, so the results are bit-identical for any thread count.
+//!
+//! # Layout
+//! - `crew`: the parallel step (shares of agents, the exchange barrier).
+//! - `board`: the values threads leave for each other (atomic words, bit-exact).
+//! - `barrier`: a barrier that spins briefly, then blocks.
+
+mod barrier;
+mod board;
+mod crew;
 
 use crate::agent::Agent;
 use crate::guard::{self, Divergence};
 use crate::network::{AgentState, Network};
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::Schedule;
+use board::Judged;
+use crew::{Board, Plan, Share};
+
+/// Fewest agents per thread [`InProcess::with_threads`] gives a thread:
+/// below it the barriers cost more than the thread saves (measured in
+/// BENCHMARKS.md, "In-process engine at scale").
+pub const MIN_AGENTS_PER_THREAD: usize = 64;
 
 /// The network's state at an output sample.
 #[derive(Debug)]
@@ -34,10 +54,15 @@ pub struct InProcess {
     /// The step of the last snapshot `run` handed out, and each agent's
     /// peak torque then.
     sampled: (u64, Vec<f64>),
+    /// Threads [`Self::run`] uses (1: the calling thread only).
+    threads: usize,
+    /// The one-thread step's published values and their verdicts
+    /// ([`crate::network::Exchanged::trust`], judged once per sender).
+    published: Vec<Judged>,
 }
 
 impl InProcess {
-    /// Builds the nodes of `net`.
+    /// Builds the nodes of `net`, to run on the calling thread.
     #[must_use]
     pub fn new(net: &Network) -> Self {
         let leader = Leader::new(net.p, net.leader, net.dt);
@@ -56,7 +81,31 @@ impl InProcess {
             step: 0,
             states,
             sampled: (0, Vec::new()),
+            threads: 1,
+            published: Vec::new(),
         }
+    }
+
+    /// Runs on up to `threads` threads, each with at least
+    /// [`MIN_AGENTS_PER_THREAD`] agents (so a small network stays on one).
+    #[must_use]
+    pub fn with_threads(self, threads: usize) -> Self {
+        let most = (self.agents.len() / MIN_AGENTS_PER_THREAD).max(1);
+        self.with_exact_threads(threads.min(most))
+    }
+
+    /// Runs on exactly `threads` threads (at most one per agent), however
+    /// few agents each gets.
+    #[must_use]
+    pub fn with_exact_threads(mut self, threads: usize) -> Self {
+        self.threads = threads.min(self.agents.len()).max(1);
+        self
+    }
+
+    /// Threads [`Self::run`] uses.
+    #[must_use]
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// Steps done so far.
@@ -82,19 +131,20 @@ impl InProcess {
     }
 
     /// Advances every node by one step (four stages, exchanging as the
-    /// coupling says).
+    /// coupling says), on the calling thread.
     pub fn step(&mut self) {
-        let mut published = Vec::with_capacity(self.agents.len());
+        let published = &mut self.published;
         for slot in Schedule::new(self.net.coupling, self.net.steps).stages(self.step) {
             if slot.exchange {
-                let from_leader = self.leader.stage_exchange();
+                let from_leader = Judged::of(self.leader.stage_exchange());
                 published.clear();
-                published.extend(self.agents.iter().map(Agent::stage_exchange));
+                published.extend(self.agents.iter().map(|a| Judged::of(a.stage_exchange())));
                 for (agent, nbrs) in self.agents.iter_mut().zip(&self.nbr_index) {
                     for (k, &j) in nbrs.iter().enumerate() {
-                        agent.receive_neighbour(k, published[j]);
+                        let Judged(x, trusted) = published[j];
+                        agent.receive_neighbour_judged(k, x, trusted);
                     }
-                    agent.receive_leader(from_leader);
+                    agent.receive_leader_judged(from_leader.0, from_leader.1);
                 }
             }
             self.leader.advance();
@@ -144,17 +194,82 @@ impl InProcess {
                 return None;
             }
         }
+        if self.threads > 1 && self.step < self.net.steps {
+            return self.run_parallel(on_sample);
+        }
         while self.step < self.net.steps {
             self.step();
             if let Some(d) = self.divergence() {
                 return Some(d);
             }
-            if (self.step % self.net.sample_every == 0 || self.step == self.net.steps)
-                && !self.sample(&mut on_sample)
-            {
+            if sample_due(&self.net, self.step) && !self.sample(&mut on_sample) {
                 return None;
             }
         }
         None
     }
+
+    /// [`Self::run`] on `self.threads` threads: the calling thread steps
+    /// the leader and the first share and samples; a worker steps each
+    /// other share (see `crew`).
+    fn run_parallel(
+        &mut self,
+        mut on_sample: impl FnMut(&Snapshot<'_>) -> bool,
+    ) -> Option<Divergence> {
+        let Self {
+            net,
+            leader,
+            agents,
+            nbr_index,
+            step,
+            states,
+            threads,
+            sampled,
+            ..
+        } = self;
+        let board = Board::new(agents.len(), *threads);
+        let plan = Plan {
+            schedule: Schedule::new(net.coupling, net.steps),
+            nbr_index,
+        };
+        let from = *step;
+        std::thread::scope(|scope| {
+            let mut shares = Share::split(agents, *threads).into_iter();
+            let mut mine = shares.next().expect("at least one share");
+            for share in shares {
+                let board = &board;
+                scope.spawn(move || crew::work(share, board, plan, from));
+            }
+            while *step < net.steps {
+                mine.step(&board, plan, *step, Some(leader));
+                crew::read_states(&board, states);
+                *step += 1;
+                if let Some(d) = guard::first(net, *step, leader.state(), states) {
+                    crew::release(&board, false);
+                    return Some(d);
+                }
+                let due = sample_due(net, *step);
+                if due {
+                    sampled.0 = *step;
+                    crew::read_peaks(&board, &mut sampled.1);
+                }
+                let snapshot = Snapshot {
+                    step: *step,
+                    leader: leader.state(),
+                    agents: states,
+                };
+                let go_on = !due || on_sample(&snapshot);
+                crew::release(&board, go_on);
+                if !go_on {
+                    return None;
+                }
+            }
+            None
+        })
+    }
+}
+
+/// Whether the state after `step` steps is an output sample.
+fn sample_due(net: &Network, step: u64) -> bool {
+    step % net.sample_every == 0 || step == net.steps
 }

@@ -6,6 +6,7 @@
 //! ./target/release/attsync-bench run --out bench-results.md       # full, ~10–15 min on 2 cores
 //! ./target/release/attsync-bench run --quick --out quick.md       # ~2 min, one repetition
 //! ./target/release/attsync-bench run --only tree-32 --reps 1      # one case
+//! ./target/release/attsync-bench scale --agents 10,100,1000 --threads 1,2   # in-process scale
 //! ```
 //! It needs `attsync`, `attsync-agent` and `attsync-leader` beside it (or
 //! `--bin-dir`), and the paper scenarios (`--scenarios`, default
@@ -26,6 +27,7 @@
 //! - [`measure`]: one `attsync run`, its figures read from `summary.json`.
 //! - [`bare`]: one bare lockstep of `ring-node` processes; [`ring`]: one
 //!   `ring-node` process.
+//! - [`scale`]: `scale` — the in-process engine against N and threads.
 //! - [`procs`]: child processes with bounded waits; [`stats`]: medians, CPU
 //!   load, the machine; [`error`]: [`error::BenchError`].
 
@@ -34,6 +36,7 @@ mod error;
 mod measure;
 mod procs;
 mod ring;
+mod scale;
 mod stats;
 mod suite;
 
@@ -89,6 +92,29 @@ enum Cmd {
     },
     /// (internal) A CPU-bound competitor of the contention case: spins until killed.
     Burn,
+    /// In-process scale: agent-steps/s of the in-process engine against N
+    /// agents and threads, per scheme (networks built in memory; a Markdown table).
+    Scale {
+        /// Numbers of agents, comma-separated.
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "10,100,1000,10000,100000"
+        )]
+        agents: Vec<u32>,
+        /// Thread counts, comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "1,2")]
+        threads: Vec<usize>,
+        /// Schemes (repeatable; default: all three).
+        #[arg(long, value_enum)]
+        scheme: Vec<scale::tree::SchemeArg>,
+        /// Use exactly the threads asked for, however few agents each gets.
+        #[arg(long)]
+        exact: bool,
+        /// Agent-steps per measurement.
+        #[arg(long, default_value_t = scale::BUDGET)]
+        budget: u64,
+    },
     /// (internal) One process of the bare iceoryx2 lockstep ring.
     RingNode {
         /// Run id (iceoryx2 namespace).
@@ -177,6 +203,16 @@ fn main() -> ExitCode {
 fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
     match cmd {
         Cmd::Burn => suite::burn(),
+        Cmd::Scale {
+            agents,
+            threads,
+            scheme,
+            exact,
+            budget,
+        } => {
+            scale_table(&agents, &threads, &scheme, (exact, budget));
+            Ok(())
+        }
         Cmd::RingNode {
             run,
             root,
@@ -234,6 +270,37 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             run(opts, out)
         }
     }
+}
+
+/// `attsync-bench scale`: measures every (scheme, N, threads), printing
+/// each figure as it comes (stderr) and the table at the end.
+fn scale_table(
+    agents: &[u32],
+    threads: &[usize],
+    schemes: &[scale::tree::SchemeArg],
+    (exact, budget): (bool, u64),
+) {
+    let schemes = if schemes.is_empty() {
+        &scale::tree::SchemeArg::ALL[..]
+    } else {
+        schemes
+    };
+    let mut figures = Vec::new();
+    for &s in schemes {
+        for &n in agents.iter().filter(|&&n| n > 0) {
+            for &t in threads.iter().filter(|&&t| t > 0) {
+                let f = scale::measure(s, n, t, exact, budget);
+                eprintln!(
+                    "{} N={n} threads={t} ({}): {:.3e} agent-steps/s",
+                    s.name(),
+                    f.threads,
+                    f.agent_steps_per_s()
+                );
+                figures.push(f);
+            }
+        }
+    }
+    print!("{}", scale::table(&figures, threads));
 }
 
 /// The arguments of `run` that become [`suite::Options`].

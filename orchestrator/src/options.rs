@@ -7,7 +7,7 @@
 //!   --duration`): finite, > 0 and at most [`MAX_SECONDS`] (1 day);
 //! - `--realtime` factor: finite, > 0 and at most [`MAX_REALTIME`];
 //! - `--tolerance`, `--quantum`: finite and > 0;
-//! - `--jobs`: ≥ 1; `--bisect`: 1..=[`MAX_BISECT`].
+//! - `--jobs`, `--threads`: ≥ 1; `--bisect`: 1..=[`MAX_BISECT`].
 //!
 //! `--no-stiffness-check` (`run`, `check`, `sweep`) is a [`StiffnessCheck`]:
 //! it turns validation's refusal of a `simulation.dt` clearly beyond RK4's
@@ -140,6 +140,14 @@ pub fn count(option: &'static str, value: u64, min: u64, max: u64) -> Result<(),
         format!("must be in {min}..={max}")
     };
     Err(out_of_range(option, value, expected))
+}
+
+/// `--threads` (in-process engine): at least 1.
+///
+/// # Errors
+/// The value is 0.
+pub fn threads(value: usize) -> Result<(), OptionError> {
+    count("--threads", value as u64, 1, u64::MAX)
 }
 
 /// `gen tree`'s `--agents` (≥ 1), `--leader-links` (1..=agents) and

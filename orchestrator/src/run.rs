@@ -46,17 +46,27 @@ pub struct RunOptions {
     pub processes: ProcessOptions,
     /// Draw a progress bar on stderr (it also hides itself when stderr is not a terminal).
     pub progress: bool,
+    /// In-process engine: threads to step the agents on (≥ 1; a small
+    /// network uses fewer, see [`InProcess::with_threads`]; [`default_threads`]).
+    pub threads: usize,
+}
+
+/// The default `--threads`: the number of cores (1 if unknown).
+#[must_use]
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
 }
 
 impl RunOptions {
     /// Checks the options that do not depend on the scenario
-    /// (`--stage-timeout`, `--realtime`; limits in [`crate::options`]).
+    /// (`--stage-timeout`, `--realtime`, `--threads`; limits in [`crate::options`]).
     ///
     /// # Errors
     /// The first option out of its range.
     pub fn validate(&self) -> Result<(), OptionError> {
         options::seconds("--stage-timeout", self.processes.stage_timeout)?;
         options::seconds("--start-timeout", self.processes.start_timeout)?;
+        options::threads(self.threads)?;
         if let Some(f) = self.processes.realtime {
             options::realtime(f)?;
         }
@@ -120,9 +130,10 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
     std::fs::write(layout.scenario(), text).map_err(io_at(layout.root()))?;
     let started = Instant::now();
-    let (outcome, series) = drive(loaded, opts, &layout, interrupt)?;
+    let (outcome, series, threads) = drive(loaded, opts, &layout, interrupt)?;
     let wall_seconds = started.elapsed().as_secs_f64();
-    let summary = summarise(loaded, opts, outcome, &series, wall_seconds);
+    let mut summary = summarise(loaded, opts, outcome, &series, wall_seconds);
+    summary.threads = threads;
     write_results(&layout, &summary, &series)?;
     staging.commit().map_err(io_at(&opts.out))?;
     tracing::debug!(out = %opts.out.display(), complete = summary.complete, "run: committed");
@@ -130,13 +141,14 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
 }
 
 /// Runs the engine, recording every snapshot into `layout`; how it ended
-/// (its failure naming the signal if interrupted) and the recorded series.
+/// (its failure naming the signal if interrupted), the recorded series and
+/// the in-process engine's thread count.
 fn drive(
     loaded: &Loaded,
     opts: &RunOptions,
     layout: &RunLayout,
     interrupt: &Interrupt,
-) -> Result<(Outcome, Vec<Series>), RunError> {
+) -> Result<(Outcome, Vec<Series>, Option<usize>), RunError> {
     let net = &loaded.resolved.network;
     let dir = layout.root();
     let mut recorder = Recorder::new(dir, &loaded.name(), net).map_err(io_at(dir))?;
@@ -150,9 +162,11 @@ fn drive(
         bar.set_position(snap.step);
         true
     };
+    let mut threads = None;
     let outcome = match opts.engine {
         Engine::InProcess => {
-            let mut engine = InProcess::new(net);
+            let mut engine = InProcess::new(net).with_threads(opts.threads);
+            threads = Some(engine.threads());
             let mut interrupted = false;
             let diverged = engine.run(|snap| {
                 interrupted = interrupt.is_set();
@@ -184,7 +198,7 @@ fn drive(
                 _ => f,
             }),
     };
-    Ok((Outcome { failure, ..outcome }, series))
+    Ok((Outcome { failure, ..outcome }, series, threads))
 }
 
 /// `summary.json` of a run that ended as `outcome` with `series` recorded.
@@ -231,6 +245,7 @@ fn summarise(
         nodes: (outcome.nodes.iter())
             .map(|(name, id, d)| NodeSummary::of(*id, name, d))
             .collect(),
+        threads: None,
     }
 }
 
@@ -354,6 +369,7 @@ mod tests {
             out,
             processes: ProcessOptions::default(),
             progress: false,
+            threads: 1,
         }
     }
 
@@ -372,6 +388,10 @@ mod tests {
             let e = o.validate().unwrap_err();
             assert!(e.to_string().starts_with("--realtime"), "{e}");
         }
+        let mut o = options(PathBuf::new());
+        o.threads = 0;
+        let e = o.validate().unwrap_err();
+        assert_eq!(e.to_string(), "--threads 0: must be at least 1");
     }
 
     #[test]

@@ -8,7 +8,9 @@
 //! Policy (all here, where tests reach it): every value must make a valid
 //! scenario before anything runs ([`load_checked`], exit code 2 like an
 //! invalid `--set`); bisection points are rounded to a quantum, by default
-//! the step `simulation.dt` for a timing field ([`default_quantum`]).
+//! the step `simulation.dt` for a timing field ([`default_quantum`]);
+//! `--jobs` × `--threads` stays within the cores unless both are given
+//! ([`jobs_and_threads`]).
 
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError, StiffnessCheck};
@@ -200,6 +202,25 @@ pub fn oversubscription(engine: Engine, jobs: usize, nodes: usize, cores: usize)
             jobs * nodes
         )
     })
+}
+
+/// `--jobs` and `--threads` of a sweep, from what was given: both given,
+/// both kept; only `--threads T`: `jobs = max(1, cores / T)`; otherwise
+/// `jobs` (default the cores) runs of `max(1, cores / jobs)` threads each.
+/// So by default `jobs × threads` does not exceed the cores (a sweep of
+/// many values gains more from whole runs in parallel than from threads
+/// inside each).
+#[must_use]
+pub fn jobs_and_threads(jobs: Option<usize>, threads: Option<usize>) -> (usize, usize) {
+    let cores = cores();
+    match (jobs, threads) {
+        (Some(j), Some(t)) => (j, t),
+        (None, Some(t)) => ((cores / t.max(1)).max(1), t),
+        (j, None) => {
+            let j = j.unwrap_or(cores);
+            (j, (cores / j.max(1)).max(1))
+        }
+    }
 }
 
 /// One run of a sweep.
@@ -568,6 +589,7 @@ mod tests {
                 out: PathBuf::from("unused"),
                 processes: ProcessOptions::default(),
                 progress: false,
+                threads: 1,
             },
             tolerance: 1e-3,
             find_margin: Some(Bisection {
@@ -575,6 +597,21 @@ mod tests {
                 quantum: None,
             }),
             stiffness: StiffnessCheck::Refuse,
+        }
+    }
+
+    #[test]
+    fn jobs_times_threads_stay_within_the_cores_by_default() {
+        let cores = cores();
+        assert_eq!(jobs_and_threads(None, None), (cores, 1));
+        assert_eq!(jobs_and_threads(Some(3), Some(5)), (3, 5));
+        let (j, t) = jobs_and_threads(None, Some(cores));
+        assert_eq!((j, t), (1, cores));
+        let (j, t) = jobs_and_threads(Some(1), None);
+        assert_eq!((j, t), (1, cores));
+        for given in 1..=2 * cores {
+            let (j, t) = jobs_and_threads(Some(given), None);
+            assert!(j * t <= cores.max(given), "{j} × {t}");
         }
     }
 

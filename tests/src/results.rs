@@ -107,9 +107,10 @@ pub fn assert_same_bytes(a: &Path, b: &Path) {
 
 /// Asserts two results directories hold the same run: byte-identical
 /// `errors.csv`, `scenario.toml` and (where written) `states.bin`, and the
-/// same `summary.json` except `engine`, `wall_seconds` and `nodes` (wall-clock
+/// same `summary.json` except `engine`, `wall_seconds`, `nodes` (wall-clock
 /// times and memory of the processes engine's nodes: neither deterministic
-/// nor written by the in-process engine).
+/// nor written by the in-process engine) and `threads` (the in-process
+/// engine's thread count, absent for the processes engine).
 #[track_caller]
 pub fn assert_same_results(a: &Path, b: &Path) {
     assert_same_file(&a.join("errors.csv"), &b.join("errors.csv"));
@@ -125,7 +126,7 @@ pub fn assert_same_results(a: &Path, b: &Path) {
             b.display()
         ),
     }
-    let skip = ["engine", "wall_seconds", "nodes"];
+    let skip = ["engine", "wall_seconds", "nodes", "threads"];
     assert_eq!(
         summary_without(a, &skip),
         summary_without(b, &skip),

@@ -104,6 +104,10 @@ pub struct Summary {
     /// Processes engine: what every node that finished reported (empty in-process).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub nodes: Vec<NodeSummary>,
+    /// In-process engine: the threads that stepped the agents (absent for
+    /// the processes engine).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threads: Option<usize>,
 }
 
 /// Where a run diverged: the first state outside the envelope

@@ -9,7 +9,7 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// `attsync run SCENARIO [--engine E] [--wait W] [--stage-timeout S]
-/// [--realtime [FACTOR]] [--out DIR] [--set K=V]… [--quiet]
+/// [--realtime [FACTOR]] [--threads N] [--out DIR] [--set K=V]… [--quiet]
 /// [--no-stiffness-check]`.
 #[derive(Debug, clap::Args)]
 pub struct Run {
@@ -23,6 +23,11 @@ pub struct Run {
     /// Not deterministic. Without it: deterministic lockstep.
     #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]
     pub realtime: Option<f64>,
+    /// In-process engine: threads that step the agents (≥ 1; each gets at
+    /// least 64 agents, so a small network runs on fewer) [default: number
+    /// of cores]. The results are bit-identical for any N.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
     /// Results directory [default: results/<scenario name>].
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -43,6 +48,7 @@ pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
         out: a.out.clone().unwrap_or_default(),
         processes: a.engine.process_options(a.realtime),
         progress: !a.quiet && std::io::stderr().is_terminal(),
+        threads: a.threads.unwrap_or_else(run::default_threads),
     };
     opts.validate()?;
     let loaded = a

@@ -5,7 +5,7 @@ use super::{EngineArgs, ScenarioArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::options::StiffnessCheck;
-use attsync::run::RunOptions;
+use attsync::run::{Engine, RunOptions};
 use attsync::sweep::{self, Bisection, SweepOptions};
 use std::path::PathBuf;
 
@@ -20,9 +20,12 @@ pub struct Sweep {
     /// Values, comma-separated (TOML literals).
     #[arg(long, value_delimiter = ',', required = true)]
     pub values: Vec<String>,
-    /// Runs at once [default: in-process, the number of cores; processes, as many runs as fit the cores (nodes × runs ≤ cores), at least 1].
+    /// Runs at once [default: in-process, the number of cores (or cores / --threads); processes, as many runs as fit the cores (nodes × runs ≤ cores), at least 1].
     #[arg(long)]
     pub jobs: Option<usize>,
+    /// In-process engine: threads per run (≥ 1) [default: cores / jobs, at least 1].
+    #[arg(long)]
+    pub threads: Option<usize>,
     #[command(flatten)]
     pub engine: EngineArgs,
     /// Sweep directory [default: results/<scenario name>-sweep-<param>].
@@ -48,17 +51,19 @@ pub struct Sweep {
 
 /// Runs the sweep and prints its table.
 pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
+    let (jobs, threads) = sweep::jobs_and_threads(a.jobs, a.threads);
     let mut o = SweepOptions {
         scenario: a.scenario.scenario.clone(),
         param: a.param,
         values: a.values,
-        jobs: a.jobs.unwrap_or(1),
+        jobs,
         set: a.scenario.overrides.set.clone(),
         run: RunOptions {
             engine: a.engine.engine,
             out: a.out.clone().unwrap_or_default(),
             processes: a.engine.process_options(None),
             progress: false,
+            threads,
         },
         tolerance: a.tolerance,
         find_margin: a.find_margin.then_some(Bisection {
@@ -71,13 +76,14 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
     let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
     let nodes = base.resolved.network.agents.len() + 1;
     let cores = sweep::cores();
-    match a.jobs {
-        None => o.jobs = sweep::default_jobs(o.run.engine, nodes, cores),
-        Some(jobs) => {
+    match (o.run.engine, a.jobs) {
+        (Engine::Processes, None) => o.jobs = sweep::default_jobs(o.run.engine, nodes, cores),
+        (_, Some(jobs)) => {
             if let Some(w) = sweep::oversubscription(o.run.engine, jobs, nodes, cores) {
                 eprintln!("warning: {w}");
             }
         }
+        (Engine::InProcess, None) => {}
     }
     if a.out.is_none() {
         o.run.out = sweep::default_out(&base, &o.param);

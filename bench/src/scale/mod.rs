@@ -1,0 +1,167 @@
+//! `attsync-bench scale`: the in-process engine's agent-steps per second
+//! against the number of agents N and of threads, per scheme, on networks
+//! built in memory ([`tree`]), without any output (the engine alone).
+//!
+//! Each measurement runs about [`BUDGET`] agent-steps (or `--budget`) (at least
+//! [`MIN_STEPS`] steps) after one untimed warm-up step, and reports
+//! agent-steps/s = N × steps ÷ wall s, with `threads` the count the engine
+//! used ([`attitude::engine::InProcess::with_threads`] gives each thread at
+//! least 64 agents, `--exact` lifts that).
+//!
+//! # Layout
+//! - [`tree`]: the binary tree of any size.
+
+pub mod tree;
+
+use attitude::engine::InProcess;
+use std::fmt::Write as _;
+use std::time::Instant;
+use tree::SchemeArg;
+
+/// Agent-steps per measurement.
+pub const BUDGET: u64 = 2_000_000;
+
+/// Fewest steps per measurement.
+pub const MIN_STEPS: u64 = 10;
+
+/// One measurement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// Scheme.
+    pub scheme: SchemeArg,
+    /// Agents.
+    pub agents: u32,
+    /// Threads asked for.
+    pub asked: usize,
+    /// Threads the engine used.
+    pub threads: usize,
+    /// Steps timed.
+    pub steps: u64,
+    /// Wall time of the timed steps, s.
+    pub seconds: f64,
+    /// Whether every agent's final state is finite (the run did not diverge).
+    pub finite: bool,
+}
+
+impl Figure {
+    /// Agent-steps per second.
+    pub fn agent_steps_per_s(&self) -> f64 {
+        f64::from(self.agents) * self.steps as f64 / self.seconds
+    }
+}
+
+/// Runs `agents` agents under `scheme` on `threads` threads (`exact`: as
+/// many as asked, however few agents each gets).
+/// About `budget` agent-steps are timed.
+pub fn measure(scheme: SchemeArg, agents: u32, threads: usize, exact: bool, budget: u64) -> Figure {
+    let steps = (budget / u64::from(agents)).max(MIN_STEPS);
+    let net = tree::network(agents, scheme, steps + 1);
+    let engine = InProcess::new(&net);
+    let mut engine = if exact {
+        engine.with_exact_threads(threads)
+    } else {
+        engine.with_threads(threads)
+    };
+    engine.step();
+    let started = Instant::now();
+    let mut finite = true;
+    engine.run(|snap| {
+        if snap.step == net.steps {
+            finite = snap
+                .agents
+                .iter()
+                .all(|a| a.r.iter().chain(&a.w).all(|v| v.is_finite()));
+        }
+        true
+    });
+    Figure {
+        scheme,
+        agents,
+        asked: threads,
+        threads: engine.threads(),
+        steps,
+        seconds: started.elapsed().as_secs_f64(),
+        finite,
+    }
+}
+
+/// The Markdown table of `figures`: one row per (scheme, N), one column
+/// per thread count asked.
+pub fn table(figures: &[Figure], threads: &[usize]) -> String {
+    let mut s = String::from("| scheme | N | steps |");
+    for t in threads {
+        let _ = write!(s, " threads {t}: agent-steps/s (used) |");
+    }
+    s.push_str("\n|---|---:|---:|");
+    for _ in threads {
+        s.push_str("---:|");
+    }
+    let mut rows: Vec<(SchemeArg, u32)> = figures.iter().map(|f| (f.scheme, f.agents)).collect();
+    rows.dedup();
+    for (scheme, n) in rows {
+        let of = |t: usize| {
+            figures
+                .iter()
+                .find(|f| (f.scheme, f.agents, f.asked) == (scheme, n, t))
+        };
+        let steps = of(threads[0]).map_or(0, |f| f.steps);
+        let _ = write!(s, "\n| {} | {n} | {steps} |", scheme.name());
+        for &t in threads {
+            match of(t) {
+                Some(f) => {
+                    let mark = if f.finite { "" } else { " (diverged)" };
+                    let _ = write!(s, " {:.3e} ({}){mark} |", f.agent_steps_per_s(), f.threads);
+                }
+                None => s.push_str(" – |"),
+            }
+        }
+    }
+    s.push('\n');
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every sample of a run: step and the bits of every agent's state.
+    fn trajectory(net: &attitude::network::Network, threads: usize) -> Vec<(u64, Vec<u64>)> {
+        let mut out = Vec::new();
+        InProcess::new(net).with_exact_threads(threads).run(|snap| {
+            let bits = (snap.agents.iter())
+                .flat_map(|a| {
+                    a.r.iter()
+                        .chain(&a.w)
+                        .chain(&a.r_hat)
+                        .chain(&a.w_hat)
+                        .chain(&a.s_hat)
+                })
+                .map(|v| v.to_bits())
+                .collect();
+            out.push((snap.step, bits));
+            true
+        });
+        out
+    }
+
+    #[test]
+    fn a_10_000_agent_tree_runs_bit_identically_on_1_and_2_threads() {
+        let net = tree::network(10_000, SchemeArg::ObserverTimeVarying, 20);
+        let one = trajectory(&net, 1);
+        assert_eq!(one.len(), 3, "samples at t = 0, 10 and 20 steps");
+        let last = &one[2].1;
+        assert!(last.iter().all(|&b| f64::from_bits(b).is_finite()));
+        assert_ne!(one[0].1, *last, "the network moved");
+        assert_eq!(trajectory(&net, 2), one);
+    }
+
+    #[test]
+    fn the_table_has_a_row_per_scheme_and_size() {
+        let f = measure(SchemeArg::Observerless, 10, 2, true, BUDGET);
+        assert_eq!(f.threads, 2);
+        assert!(f.finite && f.steps == BUDGET / 10 && f.seconds > 0.0);
+        let t = table(&[f], &[2, 1]);
+        assert!(t.contains("| observerless | 10 | 200000 |"), "{t}");
+        assert!(t.contains("(2) |") && t.contains(" – |"), "{t}");
+    }
+}
