@@ -19,8 +19,10 @@
 //! - `shutdown`: `Stop` and the exits, or killing every node.
 //! - [`supervise`]: the node processes (tokio): spawn, exits, kill.
 //! - [`namespace`]: a run's iceoryx2 namespace on this machine.
+//! - [`capacity`]: how many nodes this machine can run, checked before anything starts.
 
 mod blame;
+pub mod capacity;
 mod collect;
 mod configs;
 pub mod namespace;

@@ -121,8 +121,13 @@ pub struct StatesWriter {
     w: BufWriter<File>,
 }
 
+/// An encoding error as the I/O error it is (a full disk says
+/// "No space left on device", not bincode's debug struct).
 fn enc(e: bincode::error::EncodeError) -> io::Error {
-    io::Error::other(e.to_string())
+    match e {
+        bincode::error::EncodeError::Io { inner, .. } => inner,
+        e => io::Error::other(e.to_string()),
+    }
 }
 
 impl StatesWriter {
