@@ -258,7 +258,7 @@ fn warnings(host: &Host, need: &Need) -> Vec<String> {
     if need.nodes > NODES_PER_CORE_WARN * cores {
         out.push(format!(
             "{} nodes on {cores} cores: start-up alone may take tens of seconds \
-             (raise --start-timeout if it times out, or use --engine in-process)",
+             and reach the start-up timeout (or use --engine in-process)",
             need.nodes
         ));
     }
@@ -352,7 +352,11 @@ fn count_tasks(uid: u32, per_user: bool) -> (u64, u64) {
         .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
         .filter_map(|pid| std::fs::read_to_string(format!("/proc/{pid}/status")).ok())
         .filter_map(|s| {
-            let field = |k: &str| s.lines().find(|l| l.starts_with(k)).map(|l| l[k.len()..].to_owned());
+            let field = |k: &str| {
+                s.lines()
+                    .find(|l| l.starts_with(k))
+                    .map(|l| l[k.len()..].to_owned())
+            };
             let real_uid: u32 = field("Uid:")?.split_whitespace().next()?.parse().ok()?;
             let threads: u64 = field("Threads:")?.trim().parse().ok()?;
             (real_uid == uid).then_some(threads)
@@ -416,7 +420,10 @@ mod tests {
         assert_eq!(e.engine, "processes");
         assert!(e.limit.contains("RLIMIT_NOFILE"), "{e}");
         let text = e.to_string();
-        assert!(text.contains("5001 nodes") && text.contains("ulimit -n 51200"), "{text}");
+        assert!(
+            text.contains("5001 nodes") && text.contains("ulimit -n 50176"),
+            "{text}"
+        );
         assert!(text.contains("--engine in-process"), "{text}");
     }
 
@@ -475,7 +482,10 @@ mod tests {
     #[test]
     fn many_nodes_per_core_and_spinning_nodes_are_warned_about() {
         let w = processes(&host(), &need(201)).expect("fits");
-        assert!(w.len() == 1 && w[0].contains("201 nodes on 2 cores"), "{w:?}");
+        assert!(
+            w.len() == 1 && w[0].contains("201 nodes on 2 cores"),
+            "{w:?}"
+        );
         let spin = Need {
             spin: true,
             ..need(3)
@@ -497,7 +507,10 @@ mod tests {
         };
         let e = in_process(&h, &long).unwrap_err();
         assert_eq!(e.engine, "in-process");
-        assert!(e.to_string().contains("5000 agents × 4000001 samples"), "{e}");
+        assert!(
+            e.to_string().contains("5000 agents × 4000001 samples"),
+            "{e}"
+        );
     }
 
     #[test]

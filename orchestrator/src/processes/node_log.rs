@@ -53,7 +53,9 @@ impl CappedLog {
 /// node (named by the file) and the OS error.
 #[must_use]
 pub fn unwritable(path: &Path, e: &std::io::Error) -> String {
-    let node = path.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let node = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
     format!(
         "writing {}: {e}: the log of {node} stops here (its further output is discarded; the node runs on)",
         path.display()
@@ -154,7 +156,10 @@ mod tests {
         log.write(b"more");
         let e = std::io::Error::from_raw_os_error(28);
         let text = unwritable(&log.path, &e);
-        assert!(text.starts_with("writing /r/logs/agent-7.log: No space left"), "{text}");
+        assert!(
+            text.starts_with("writing /r/logs/agent-7.log: No space left"),
+            "{text}"
+        );
         assert!(text.contains("the log of agent-7 stops here"), "{text}");
     }
 

@@ -122,11 +122,17 @@ impl<'a> Session<'a> {
             .filter(|s| !s.ready)
             .partition(|s| !connected(s.id));
         let labels = |v: &[&super::collect::NodeSlot]| {
-            v.iter().map(|s| s.label.as_str()).collect::<Vec<_>>().join(", ")
+            v.iter()
+                .map(|s| s.label.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
         };
         let t = self.opts.start_timeout;
         match (silent.is_empty(), waiting.is_empty()) {
-            (true, _) => format!("start-up timed out after {t} s: not ready: {}", labels(&waiting)),
+            (true, _) => format!(
+                "start-up timed out after {t} s: not ready: {}",
+                labels(&waiting)
+            ),
             (false, true) => format!(
                 "start-up timed out after {t} s: never connected (opened no ports): {}",
                 labels(&silent)
@@ -135,7 +141,10 @@ impl<'a> Session<'a> {
                 "start-up timed out after {t} s: never connected (opened no ports): {}\n\
                  (connected, but left waiting for them: {})",
                 labels(&silent),
-                (waiting.iter()).map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ")
+                (waiting.iter())
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ),
         }
     }
