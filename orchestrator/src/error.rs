@@ -119,7 +119,7 @@ mod tests {
             have: "is 64".into(),
             advice: "raise it".into(),
         };
-        assert_eq!(Error::from(RunError::Capacity(capacity)).exit_code(), 2);
+        assert_eq!(Error::from(RunError::from(capacity)).exit_code(), 2);
         assert_eq!(Error::NotConforming.exit_code(), 1);
         assert_eq!(Error::Export("bad file".into()).exit_code(), 1);
         let run = SweepError::Run {

@@ -90,7 +90,7 @@ pub enum RunError {
     Options(#[from] OptionError),
     /// This machine cannot run the scenario with the chosen engine (nothing started).
     #[error(transparent)]
-    Capacity(#[from] CapacityError),
+    Capacity(Box<CapacityError>),
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -99,6 +99,12 @@ pub enum RunError {
         /// What went wrong.
         message: String,
     },
+}
+
+impl From<CapacityError> for RunError {
+    fn from(e: CapacityError) -> Self {
+        RunError::Capacity(Box::new(e))
+    }
 }
 
 fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
