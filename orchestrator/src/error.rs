@@ -4,7 +4,7 @@
 //! | code | meaning |
 //! |---|---|
 //! | 0 | success |
-//! | 2 | invalid scenario, `--set` or option (nothing was started) |
+//! | 2 | invalid scenario, `--set` or option, or a run this machine cannot take (nothing was started) |
 //! | 1 | any other error (a node died, a rule failed, a file could not be written…) |
 //! | 3 | the run diverged: a state left the envelope (`summary.json` `diverged`) |
 //! | 128 + N | interrupted by signal N: 130 SIGINT, 143 SIGTERM, 129 SIGHUP |
@@ -94,7 +94,7 @@ pub const DIVERGED: u8 = 3;
 
 fn run_code(e: &RunError) -> u8 {
     match e {
-        RunError::Options(_) => 2,
+        RunError::Options(_) | RunError::Capacity(_) => 2,
         _ => 1,
     }
 }
@@ -116,6 +116,15 @@ mod tests {
             Error::from(RunEnd::Failed("node died".into())).exit_code(),
             1
         );
+        let capacity = crate::processes::capacity::CapacityError {
+            engine: "processes",
+            nodes: 5001,
+            limit: "the open-file limit".into(),
+            need: "50 064 open files".into(),
+            have: "is 64".into(),
+            advice: "raise it".into(),
+        };
+        assert_eq!(Error::from(RunError::from(capacity)).exit_code(), 2);
         assert_eq!(Error::NotConforming.exit_code(), 1);
         let diverged = RunEnd::Diverged("diverged at t = 0.01 s: …".into());
         assert_eq!(Error::from(diverged).exit_code(), 3);

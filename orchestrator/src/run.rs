@@ -4,10 +4,11 @@
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
 use crate::outcome::Outcome;
+use crate::processes::capacity::{self, CapacityError, Host, Need};
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::results::layout::RunLayout;
 use crate::results::summary::{Diverged, LinkSummary, NodeSummary};
-use crate::results::{self, Recorder, Series, Summary, plot, staging::Staging};
+use crate::results::{self, Recorder, Series, Summary, WriteError, plot, staging::Staging};
 use crate::scenario::Loaded;
 use attitude::engine::InProcess;
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
@@ -97,6 +98,9 @@ pub enum RunError {
     /// The options are out of range or do not fit the scenario.
     #[error(transparent)]
     Options(#[from] OptionError),
+    /// This machine cannot run the scenario with the chosen engine (nothing started).
+    #[error(transparent)]
+    Capacity(Box<CapacityError>),
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -105,6 +109,12 @@ pub enum RunError {
         /// What went wrong.
         message: String,
     },
+}
+
+impl From<CapacityError> for RunError {
+    fn from(e: CapacityError) -> Self {
+        RunError::Capacity(Box::new(e))
+    }
 }
 
 fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
@@ -120,6 +130,7 @@ fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<Summary, RunError> {
     opts.validate()?;
     check_options(loaded, opts)?;
+    check_capacity(loaded, opts)?;
     let staging = Staging::claim(&opts.out).map_err(|e| match e {
         // A foreign or busy --out: refused before anything started (exit 2).
         e if e.is_refusal() => RunError::Options(OptionError::Conflict(e.to_string())),
@@ -128,7 +139,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     tracing::debug!(staging = %staging.path().display(), engine = opts.engine.name(), "run: staged");
     let layout = RunLayout::new(staging.path());
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
-    std::fs::write(layout.scenario(), text).map_err(io_at(layout.root()))?;
+    std::fs::write(layout.scenario(), text).map_err(io_at(&layout.scenario()))?;
     let started = Instant::now();
     let (outcome, series, threads) = drive(loaded, opts, &layout, interrupt)?;
     let wall_seconds = started.elapsed().as_secs_f64();
@@ -151,7 +162,7 @@ fn drive(
 ) -> Result<(Outcome, Vec<Series>, Option<usize>), RunError> {
     let net = &loaded.resolved.network;
     let dir = layout.root();
-    let mut recorder = Recorder::new(dir, &loaded.name(), net).map_err(io_at(dir))?;
+    let mut recorder = Recorder::new(dir, &loaded.name(), net).map_err(written)?;
     let bar = progress_bar(opts.progress, net.steps, net.dt);
     let mut write_error = None;
     let mut record = |snap: &attitude::engine::Snapshot<'_>| {
@@ -182,9 +193,9 @@ fn drive(
     };
     bar.finish_and_clear();
     if let Some(e) = write_error {
-        return Err(io_at(dir)(e));
+        return Err(written(e));
     }
-    let series = recorder.finish().map_err(io_at(dir))?;
+    let series = recorder.finish().map_err(written)?;
     // A diverged run says where, whichever engine ran it. An engine
     // stopped by the interrupt says "interrupted": say which signal.
     let failure = match &outcome.diverged {
@@ -258,7 +269,15 @@ fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Re
         path: svg.clone(),
         message,
     })?;
-    results::write_summary(layout.root(), summary).map_err(io_at(layout.root()))
+    results::write_summary(layout.root(), summary).map_err(written)
+}
+
+/// A results file that could not be written, as a [`RunError::Io`] naming it.
+fn written(e: WriteError) -> RunError {
+    RunError::Io {
+        path: e.path,
+        source: e.source,
+    }
 }
 
 /// `incomplete_reason` of an interrupted run.
@@ -333,6 +352,23 @@ fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), OptionError> 
         }
     }
     Ok(())
+}
+
+/// Refuses a run this machine cannot take with the chosen engine (before
+/// the results directory is claimed, so nothing is left behind); logs the
+/// process engine's warnings.
+fn check_capacity(loaded: &Loaded, opts: &RunOptions) -> Result<(), CapacityError> {
+    let need = Need::of(&loaded.resolved.network, opts.processes.wait);
+    let host = Host::read(&processes::namespace::base_dir());
+    match opts.engine {
+        Engine::Processes => {
+            for warning in capacity::processes(&host, &need)? {
+                tracing::warn!("{warning}");
+            }
+            Ok(())
+        }
+        Engine::InProcess => capacity::in_process(&host, &need),
+    }
 }
 
 fn progress_bar(enabled: bool, steps: u64, dt: f64) -> ProgressBar {

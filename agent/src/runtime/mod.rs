@@ -414,7 +414,7 @@ pub(crate) fn check_origin(m: &StateMsg, sender: u32) -> Result<(), NodeError> {
     Ok(())
 }
 
-/// Waits (polling every millisecond, bounded) for a control command the
+/// Waits (polling with a [`ports::Backoff`], bounded) for a control command the
 /// hooks let through; returns it with its `start_unix_ns`.
 fn wait_command<S: Service, H: Hooks>(
     io: &mut Hooked<'_, S, H>,
@@ -423,6 +423,7 @@ fn wait_command<S: Service, H: Hooks>(
     orphan: &Orphan,
 ) -> Result<Option<(ControlCommand, u64)>, NodeError> {
     let deadline = Instant::now() + timeout;
+    let mut backoff = ports::Backoff::new();
     loop {
         if let Some(sample) = io
             .ports
@@ -452,6 +453,6 @@ fn wait_command<S: Service, H: Hooks>(
                 waited: timeout.as_secs_f64(),
             });
         }
-        std::thread::sleep(Duration::from_millis(1));
+        backoff.sleep();
     }
 }

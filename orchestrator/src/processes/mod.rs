@@ -21,8 +21,10 @@
 //! - [`placement`]: spread the nodes over the cores, or pack them onto one
 //!   while the machine is busy (`load`: the CPU load it decides on).
 //! - [`namespace`]: a run's iceoryx2 namespace on this machine.
+//! - [`capacity`]: how many nodes this machine can run, checked before anything starts.
 
 mod blame;
+pub mod capacity;
 mod collect;
 mod configs;
 mod load;

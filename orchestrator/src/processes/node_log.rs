@@ -5,7 +5,7 @@
 
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use tokio::io::AsyncReadExt;
 use tokio::process::{ChildStderr, ChildStdout};
 
@@ -23,6 +23,8 @@ struct CappedLog {
     written: u64,
     cap: u64,
     cut: bool,
+    /// The log's path, named when it cannot be written.
+    path: PathBuf,
 }
 
 impl CappedLog {
@@ -32,8 +34,13 @@ impl CappedLog {
         }
         let room = usize::try_from(self.cap - self.written).unwrap_or(usize::MAX);
         let keep = &data[..data.len().min(room)];
-        // A log that cannot be written is not a reason to stop the node.
-        let _ = self.file.write_all(keep);
+        // A log that cannot be written (a full disk) is not a reason to stop
+        // the node: say so once, naming the file and the node, and drain the rest.
+        if let Err(e) = self.file.write_all(keep) {
+            tracing::warn!("{}", unwritable(&self.path, &e));
+            self.cut = true;
+            return;
+        }
         self.written += keep.len() as u64;
         if keep.len() < data.len() {
             let _ = writeln!(self.file, "\n{CUT_LINE}");
@@ -42,12 +49,27 @@ impl CappedLog {
     }
 }
 
-/// Copies `out` and `err` into `log` (at most `cap` bytes, then
-/// [`CUT_LINE`]) until both are closed, draining whatever comes after the cap.
+/// What is said when the log at `path` cannot be written: the file, the
+/// node (named by the file) and the OS error.
+#[must_use]
+pub fn unwritable(path: &Path, e: &std::io::Error) -> String {
+    let node = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    format!(
+        "writing {}: {e}: the log of {node} stops here (its further output is discarded; the node runs on)",
+        path.display()
+    )
+}
+
+/// Copies `out` and `err` into `log` (the file at `path`; at most `cap`
+/// bytes, then [`CUT_LINE`]) until both are closed, draining whatever comes
+/// after the cap or after a write error.
 pub async fn copy_capped(
     mut out: Option<ChildStdout>,
     mut err: Option<ChildStderr>,
     log: File,
+    path: PathBuf,
     cap: u64,
 ) {
     let mut log = CappedLog {
@@ -55,6 +77,7 @@ pub async fn copy_capped(
         written: 0,
         cap,
         cut: false,
+        path,
     };
     let (mut bo, mut be) = (vec![0u8; 16 << 10], vec![0u8; 16 << 10]);
     while out.is_some() || err.is_some() {
@@ -109,6 +132,7 @@ mod tests {
             written: 0,
             cap: 10,
             cut: false,
+            path: path.clone(),
         };
         log.write(b"12345678");
         log.write(b"abcdef");
@@ -116,6 +140,27 @@ mod tests {
         let text = std::fs::read_to_string(&path).unwrap();
         assert_eq!(text, format!("12345678ab\n{CUT_LINE}\n"));
         assert_eq!(tail(&path, 1), CUT_LINE);
+    }
+
+    #[test]
+    fn a_log_on_a_full_disk_is_named_with_its_node_and_drained() {
+        let mut log = CappedLog {
+            file: File::options().write(true).open("/dev/full").unwrap(),
+            written: 0,
+            cap: 1 << 20,
+            cut: false,
+            path: "/r/logs/agent-7.log".into(),
+        };
+        log.write(b"hello\n");
+        assert!(log.cut, "a failed write stops the log");
+        log.write(b"more");
+        let e = std::io::Error::from_raw_os_error(28);
+        let text = unwritable(&log.path, &e);
+        assert!(
+            text.starts_with("writing /r/logs/agent-7.log: No space left"),
+            "{text}"
+        );
+        assert!(text.contains("the log of agent-7 stops here"), "{text}");
     }
 
     #[test]

@@ -8,6 +8,7 @@ use super::namespace::{self, Namespace};
 use super::supervise::{Supervisor, find_binaries};
 use super::{Failure, ProcessError, ProcessOptions, Session, io_at};
 use attitude::network::Network;
+use iceoryx2::service::port_factory::PortFactory;
 use msgs::Limits;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -101,18 +102,51 @@ impl<'a> Session<'a> {
             self.nodes.drain(&self.ports)?;
             self.still_running()?;
             if Instant::now() > deadline {
-                let missing: Vec<&str> = (self.nodes.slots.iter())
-                    .filter(|s| !s.ready)
-                    .map(|s| s.label.as_str())
-                    .collect();
-                return Err(format!(
-                    "start-up timed out after {} s: not ready: {}",
-                    self.opts.start_timeout,
-                    missing.join(", ")
-                ));
+                return Err(self.not_ready());
             }
         }
         Ok(())
+    }
+
+    /// Why start-up timed out: the nodes that never opened their ports
+    /// first (a silent plug-in), then the nodes left waiting for them; or,
+    /// if every node opened its ports, the nodes not ready.
+    fn not_ready(&self) -> Failure {
+        let limits = Limits::of(self.net);
+        // A node that opened its ports has its telemetry publisher.
+        let connected = |id: u32| {
+            msgs::open::telemetry(self.ports.node(), self.ports.run(), id, &limits)
+                .is_ok_and(|t| t.dynamic_config().number_of_publishers() > 0)
+        };
+        let (silent, waiting): (Vec<_>, Vec<_>) = (self.nodes.slots.iter())
+            .filter(|s| !s.ready)
+            .partition(|s| !connected(s.id));
+        let labels = |v: &[&super::collect::NodeSlot]| {
+            v.iter()
+                .map(|s| s.label.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let t = self.opts.start_timeout;
+        match (silent.is_empty(), waiting.is_empty()) {
+            (true, _) => format!(
+                "start-up timed out after {t} s: not ready: {}",
+                labels(&waiting)
+            ),
+            (false, true) => format!(
+                "start-up timed out after {t} s: never connected (opened no ports): {}",
+                labels(&silent)
+            ),
+            (false, false) => format!(
+                "start-up timed out after {t} s: never connected (opened no ports): {}\n\
+                 (connected, but left waiting for them: {})",
+                labels(&silent),
+                (waiting.iter())
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }
     }
 
     /// Sends `Start` (in real-time mode: for a moment just ahead).

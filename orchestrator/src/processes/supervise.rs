@@ -113,6 +113,7 @@ impl Supervisor {
         cwd: Option<&Path>,
         log: &Path,
     ) -> std::io::Result<Option<u32>> {
+        let log_path = log.to_owned();
         let log = std::fs::File::create(log)?;
         let mut cmd = tokio::process::Command::new(program);
         if let Some(dir) = cwd {
@@ -137,7 +138,7 @@ impl Supervisor {
             let (mut child, copy) = match spawned {
                 Ok(mut c) => {
                     let (out, err) = (c.stdout.take(), c.stderr.take());
-                    let copy = node_log::copy_capped(out, err, log, node_log::LOG_CAP);
+                    let copy = node_log::copy_capped(out, err, log, log_path, node_log::LOG_CAP);
                     (c, tokio::spawn(copy))
                 }
                 Err(e) => {

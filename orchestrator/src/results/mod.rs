@@ -6,7 +6,8 @@
 //! - [`layout`]: the name of every file and directory of a run and of a
 //!   sweep (`RunLayout`, `SweepLayout`, the staging directory's name).
 //! - this module: [`Recorder`] (snapshots → `errors.csv` rows and
-//!   [`Series`], and `states.bin`), [`agent_summaries`], [`write_summary`].
+//!   [`Series`], and `states.bin`), [`agent_summaries`], [`write_summary`],
+//!   [`WriteError`] (naming the file).
 //! - [`summary`]: `summary.json` ([`Summary`]) and the end-of-run table.
 //! - [`states`]: `states.bin`, its byte layout, reader and CSV export.
 //! - [`plot`]: draws `errors.svg`.
@@ -27,7 +28,7 @@ use attitude::network::Network;
 pub use layout::{RunLayout, SweepLayout};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 pub use summary::{AgentSummary, Summary};
 
 /// The exact header of `errors.csv`.
@@ -50,9 +51,28 @@ pub struct Series {
     pub obs_angvel: Vec<f64>,
 }
 
+/// A results file could not be written (a full disk, a read-only directory).
+#[derive(Debug, thiserror::Error)]
+#[error("writing {}: {source}", path.display())]
+pub struct WriteError {
+    /// The file.
+    pub path: PathBuf,
+    /// The OS error.
+    pub source: io::Error,
+}
+
+/// Maps an I/O error writing `path` to a [`WriteError`].
+fn writing(path: &Path) -> impl FnOnce(io::Error) -> WriteError + '_ {
+    move |source| WriteError {
+        path: path.to_owned(),
+        source,
+    }
+}
+
 /// Turns snapshots into `errors.csv` rows (streamed) and in-memory series.
 #[derive(Debug)]
 pub struct Recorder {
+    files: RunLayout,
     csv: BufWriter<File>,
     states: states::StatesWriter,
     dt: f64,
@@ -74,11 +94,13 @@ pub fn fmt_time(step: u64, dt: f64) -> String {
 
 impl Recorder {
     /// Starts `errors.csv` and `states.bin` in `dir` for `net`.
-    pub fn new(dir: &Path, scenario: &str, net: &Network) -> io::Result<Self> {
+    pub fn new(dir: &Path, scenario: &str, net: &Network) -> Result<Self, WriteError> {
         let files = RunLayout::new(dir);
-        let states = states::StatesWriter::create(&files.states(), scenario, net)?;
-        let mut csv = BufWriter::new(File::create(files.errors_csv())?);
-        writeln!(csv, "{CSV_HEADER}")?;
+        let (states_file, csv_file) = (files.states(), files.errors_csv());
+        let states = states::StatesWriter::create(&states_file, scenario, net)
+            .map_err(writing(&states_file))?;
+        let mut csv = BufWriter::new(File::create(&csv_file).map_err(writing(&csv_file))?);
+        writeln!(csv, "{CSV_HEADER}").map_err(writing(&csv_file))?;
         let has_observer = net
             .agents
             .first()
@@ -92,6 +114,7 @@ impl Recorder {
             })
             .collect();
         Ok(Self {
+            files,
             csv,
             states,
             dt: net.dt,
@@ -102,8 +125,14 @@ impl Recorder {
 
     /// Writes one row per agent for `snap`. Errors are printed with Rust's
     /// shortest round-trip formatting (full f64 precision).
-    pub fn record(&mut self, snap: &Snapshot<'_>) -> io::Result<()> {
-        self.states.write(snap)?;
+    pub fn record(&mut self, snap: &Snapshot<'_>) -> Result<(), WriteError> {
+        (self.states.write(snap)).map_err(writing(&self.files.states()))?;
+        self.record_errors(snap)
+            .map_err(writing(&self.files.errors_csv()))
+    }
+
+    /// The `errors.csv` rows and series samples of `snap`.
+    fn record_errors(&mut self, snap: &Snapshot<'_>) -> io::Result<()> {
         let t_str = fmt_time(snap.step, self.dt);
         let t: f64 = t_str.parse().expect("fmt_time prints a number");
         for (x, s) in snap.agents.iter().zip(&mut self.series) {
@@ -127,10 +156,11 @@ impl Recorder {
         Ok(())
     }
 
-    /// Flushes the CSV and returns the series.
-    pub fn finish(mut self) -> io::Result<Vec<Series>> {
-        self.csv.flush()?;
-        self.states.finish()?;
+    /// Flushes the CSV and `states.bin` and returns the series.
+    pub fn finish(mut self) -> Result<Vec<Series>, WriteError> {
+        let (states, csv) = (self.files.states(), self.files.errors_csv());
+        self.csv.flush().map_err(writing(&csv))?;
+        self.states.finish().map_err(writing(&states))?;
         Ok(self.series)
     }
 }
@@ -158,7 +188,9 @@ pub fn agent_summaries(series: &[Series], peak_torques: &[f64]) -> Vec<AgentSumm
 }
 
 /// Writes `summary.json`.
-pub fn write_summary(dir: &Path, summary: &Summary) -> io::Result<()> {
-    let text = serde_json::to_string_pretty(summary).map_err(io::Error::other)?;
-    std::fs::write(RunLayout::new(dir).summary(), text + "\n")
+pub fn write_summary(dir: &Path, summary: &Summary) -> Result<(), WriteError> {
+    let file = RunLayout::new(dir).summary();
+    let text = serde_json::to_string_pretty(summary).map_err(io::Error::other);
+    text.and_then(|t| std::fs::write(&file, t + "\n"))
+        .map_err(writing(&file))
 }

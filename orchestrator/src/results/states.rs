@@ -121,8 +121,13 @@ pub struct StatesWriter {
     w: BufWriter<File>,
 }
 
+/// An encoding error as the I/O error it is (a full disk says
+/// "No space left on device", not bincode's debug struct).
 fn enc(e: bincode::error::EncodeError) -> io::Error {
-    io::Error::other(e.to_string())
+    match e {
+        bincode::error::EncodeError::Io { inner, .. } => inner,
+        e => io::Error::other(e.to_string()),
+    }
 }
 
 impl StatesWriter {
@@ -256,4 +261,20 @@ pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_full_disk_while_encoding_is_said_as_the_os_error() {
+        let full = bincode::error::EncodeError::Io {
+            inner: io::Error::from_raw_os_error(28),
+            index: 7,
+        };
+        let e = enc(full);
+        assert_eq!(e.kind(), io::ErrorKind::StorageFull);
+        assert_eq!(e.to_string(), "No space left on device (os error 28)");
+    }
 }
