@@ -30,7 +30,7 @@ pub struct TreeParams {
     /// Scheme (gains are the paper's for that scheme).
     pub scheme: SchemeKind,
     /// Horizon, s (`None`: [`DEFAULT_DURATION`] or longer, as the slowest
-    /// linear mode needs; see [`pick_duration`]).
+    /// linear mode needs; see [`CONVERGE_MULTIPLE`]).
     pub duration: Option<f64>,
 }
 
@@ -59,9 +59,11 @@ pub struct Generated {
 /// and gain offsets are drawn uniformly; every gain matrix is
 /// `diag(c+m, c+1+m, c+2+m)` like the paper's, so it is SPD with distinct
 /// eigenvalues. The reference excites P's oscillating mode (σ₀(0) = [0.2, 1, 0]).
-/// Scheme 1's `k_σ` satisfies Theorem 1's gain condition with a margin
-/// ([`K_SIGMA_MARGIN`]), and `dt` is within RK4's stable step
-/// ([`DT_FRACTION`]), so the scenario passes `attsync check` and stays finite.
+/// Scheme 1's `k_ω`, `k_σ` satisfy Theorem 1's gain condition with a margin
+/// ([`K_SIGMA_MARGIN`], `pick_gains`), and `dt` is within RK4's stable step
+/// ([`DT_FRACTION`]), so the scenario passes `attsync check` and stays
+/// finite; without `p.duration` the horizon is long enough for the slowest
+/// linear mode to decay (`pick_duration`, [`CONVERGE_MULTIPLE`]).
 pub fn tree(p: &TreeParams) -> Result<Generated, String> {
     if p.agents == 0 {
         return Err("--agents must be ≥ 1".into());
