@@ -41,6 +41,6 @@ pub mod observer;
 pub mod reference;
 pub mod schedule;
 pub mod so3;
-pub mod stiffness;
 pub mod sparse;
 pub mod spectrum;
+pub mod stiffness;

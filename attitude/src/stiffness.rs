@@ -154,6 +154,10 @@ pub struct LoopEstimate {
     pub name: &'static str,
     /// Largest `|λ|` of the loop's linearisation, s⁻¹.
     pub fastest_rate: f64,
+    /// Smallest `|Re λ|` of the loop's linearisation, s⁻¹: the decay rate of
+    /// its slowest mode (at `λmin(Ξ + LLᵀ)` for the graph loops), which sets
+    /// how long the loop needs to converge (`docs/stiffness.md`).
+    pub slowest_rate: f64,
     /// Largest `dt` with every `dt·λ` in RK4's stability region, s
     /// (`f64::INFINITY` when no mode limits it).
     pub dt_max: f64,
@@ -169,6 +173,16 @@ pub struct Estimate {
 }
 
 impl Estimate {
+    /// The error loop (every loop but the leader's exosystem, which is the
+    /// reference, not an error) whose slowest mode decays the slowest.
+    #[must_use]
+    pub fn slowest(&self) -> Option<&LoopEstimate> {
+        self.loops
+            .iter()
+            .filter(|l| l.name != "leader")
+            .min_by(|a, b| a.slowest_rate.total_cmp(&b.slowest_rate))
+    }
+
     /// The loop whose step limit is the smallest (the one that binds).
     #[must_use]
     pub fn binding(&self) -> Option<&LoopEstimate> {
@@ -192,6 +206,7 @@ pub fn estimate(loops: &[Loop]) -> Estimate {
             LoopEstimate {
                 name: l.name(),
                 fastest_rate: eigs.iter().map(|z| z.norm()).fold(0.0, f64::max),
+                slowest_rate: slowest_rate(&eigs),
                 dt_max: rk4_dt_max(&eigs),
             }
         })
@@ -346,6 +361,15 @@ pub fn rk4_step_limit(lambda: Complex<f64>) -> f64 {
     lo / r
 }
 
+/// The decay rate of the slowest of `eigs`: the smallest `|Re λ|`
+/// (`f64::INFINITY` for none).
+#[must_use]
+pub fn slowest_rate(eigs: &[Complex<f64>]) -> f64 {
+    eigs.iter()
+        .map(|z| z.re.abs())
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The largest stable RK4 step for a set of modes: the smallest
 /// [`rk4_step_limit`] (`f64::INFINITY` for none).
 #[must_use]
@@ -448,5 +472,30 @@ mod tests {
         assert_eq!(g.len(), 5);
         assert!((g[0] - 0.1).abs() < 1e-15 && (g[4] - 10.0).abs() < 1e-12);
         assert_eq!(Interval::point(3.0).grid(5), vec![3.0]);
+    }
+
+    /// The observer's slowest mode sits at `λmin(Ξ + LLᵀ)`: underdamped
+    /// there, it decays at `k_ω λmin / 2`; the leader is not an error loop.
+    #[test]
+    fn slowest_rate_of_an_underdamped_observer_is_half_k_w_lambda_min() {
+        let obs = Loop::Observer {
+            k_r: 9.0,
+            k_w: 14.0,
+            k_sigma: 12.0,
+            p: None,
+            e: Interval::point(10.5),
+            graph: Interval {
+                min: 0.01,
+                max: 5.0,
+            },
+        };
+        let leader = Loop::Leader {
+            p: Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -1.0),
+        };
+        let est = estimate(&[leader, obs]);
+        let slow = est.slowest().expect("an error loop");
+        assert_eq!(slow.name, "observer");
+        assert!((slow.slowest_rate - 0.07).abs() < 1e-12, "{slow:?}");
+        assert_eq!(est.loops[0].slowest_rate, 0.0);
     }
 }

@@ -1,7 +1,8 @@
 //! Generated scenarios: `attsync gen tree` builds a random tree of agents
-//! with seeded, reproducible values (ChaCha8 stream), then picks `k_σ`
-//! (Theorem 1's condition with a margin) and `dt` (RK4's stable step) so that
-//! the scenario validates and stays finite.
+//! with seeded, reproducible values (ChaCha8 stream), then picks scheme 1's
+//! `k_ω` and `k_σ` (Theorem 1's condition with a margin, balanced), `dt`
+//! (RK4's stable step) so that the scenario validates and stays finite, and
+//! the duration (the slowest linear mode) so that it converges.
 
 use crate::options::StiffnessCheck;
 use crate::scenario::Resolved;
@@ -28,8 +29,9 @@ pub struct TreeParams {
     pub seed: u64,
     /// Scheme (gains are the paper's for that scheme).
     pub scheme: SchemeKind,
-    /// Horizon, s.
-    pub duration: f64,
+    /// Horizon, s (`None`: [`DEFAULT_DURATION`] or longer, as the slowest
+    /// linear mode needs; see [`CONVERGE_MULTIPLE`]).
+    pub duration: Option<f64>,
 }
 
 /// `P` of the paper's experiment: a decaying mode and an oscillating pair `±i/√2`.
@@ -47,6 +49,9 @@ pub struct Generated {
     /// One line per choice made to keep it valid and stable (the file's
     /// header comments).
     pub notes: Vec<String>,
+    /// Set when an explicit `--duration` is shorter than the estimate of
+    /// the time to converge (`attsync gen` prints it on stderr).
+    pub warning: Option<String>,
 }
 
 /// A random tree: agent k ≥ 2 attaches to a uniformly chosen agent < k;
@@ -54,9 +59,11 @@ pub struct Generated {
 /// and gain offsets are drawn uniformly; every gain matrix is
 /// `diag(c+m, c+1+m, c+2+m)` like the paper's, so it is SPD with distinct
 /// eigenvalues. The reference excites P's oscillating mode (σ₀(0) = [0.2, 1, 0]).
-/// Scheme 1's `k_σ` satisfies Theorem 1's gain condition with a margin
-/// ([`K_SIGMA_MARGIN`]), and `dt` is within RK4's stable step
-/// ([`DT_FRACTION`]), so the scenario passes `attsync check` and stays finite.
+/// Scheme 1's `k_ω`, `k_σ` satisfy Theorem 1's gain condition with a margin
+/// ([`K_SIGMA_MARGIN`], `pick_gains`), and `dt` is within RK4's stable step
+/// ([`DT_FRACTION`]), so the scenario passes `attsync check` and stays
+/// finite; without `p.duration` the horizon is long enough for the slowest
+/// linear mode to decay (`pick_duration`, [`CONVERGE_MULTIPLE`]).
 pub fn tree(p: &TreeParams) -> Result<Generated, String> {
     if p.agents == 0 {
         return Err("--agents must be ≥ 1".into());
@@ -90,7 +97,7 @@ pub fn tree(p: &TreeParams) -> Result<Generated, String> {
         )),
         simulation: Simulation {
             dt: 0.001,
-            duration: p.duration,
+            duration: p.duration.unwrap_or(DEFAULT_DURATION),
             coupling: CouplingKind::Continuous,
             period: None,
         },
@@ -103,11 +110,17 @@ pub fn tree(p: &TreeParams) -> Result<Generated, String> {
         network: Default::default(),
         guard: Default::default(),
     };
-    let notes = [pick_k_sigma(&mut scenario), pick_dt(&mut scenario)]
+    let mut notes: Vec<String> = [pick_gains(&mut scenario), pick_dt(&mut scenario)]
         .into_iter()
         .flatten()
         .collect();
-    Ok(Generated { scenario, notes })
+    let (note, warning) = pick_duration(&mut scenario, p.duration);
+    notes.extend(note);
+    Ok(Generated {
+        scenario,
+        notes,
+        warning,
+    })
 }
 
 /// A gain matrix like the paper's: `diag(c+m, c+1+m, c+2+m)` (SPD, distinct eigenvalues).
@@ -217,30 +230,59 @@ pub const DT_FRACTION: f64 = 0.5;
 /// The paper's step, s; a generated `dt` is it divided by a round number.
 const PAPER_DT: f64 = 0.001;
 
-/// For scheme 1, `k_σ = max(paper's, K_SIGMA_MARGIN · k_σ*)`, `k_σ*` the
-/// boundary of `F > 0` (so that Theorem 1 covers the generated network; deep
-/// trees need more than the paper's 12). Returns the reason, for the file's
-/// header.
-fn pick_k_sigma(s: &mut Scenario) -> Option<String> {
+/// For scheme 1, Theorem 1's gain condition (`F > 0`, Appendix D). The
+/// paper's gains when `k_σ = 12 ≥ K_SIGMA_MARGIN · k_σ*(k_ω = 14)`;
+/// otherwise `k_ω = k_σ = k`, the smallest equal pair with
+/// `k_σ ≥ K_SIGMA_MARGIN · k_σ*(k_ω = k)` (the condition is on the product,
+/// [`balanced_gain`]: equal gains keep the fastest mode, `∝ max(k_ω, k_σ)`,
+/// and so the step, as large as possible). Confirmed by the exact test.
+/// Returns the reason, for the file's header.
+fn pick_gains(s: &mut Scenario) -> Option<String> {
     let r = crate::scenario::resolve::resolve_with(s, StiffnessCheck::Warn).ok()?;
     let o = s.scheme.observer.as_mut()?;
     let paper = o.k_sigma?;
     let p = r.network.p;
-    // The threshold is decreasing in λ > 0: λmin decides it.
+    // The thresholds are decreasing in λ > 0: λmin decides them.
     let (lo, hi) = r.spectrum_extremes;
-    let threshold = k_sigma_threshold(&[lo, hi], o.k_omega, &p);
-    let mut k = paper.max(K_SIGMA_MARGIN * threshold);
+    let nu = sym_eigenvalues(&(-(p + p.transpose()) * 0.5))[0];
+    let paper_ok = K_SIGMA_MARGIN * k_sigma_threshold(&[lo, hi], o.k_omega, nu) <= paper;
+    let (mut k_w, mut k_s) = if paper_ok {
+        (o.k_omega, paper)
+    } else {
+        let k = balanced_gain(&[lo, hi], nu, K_SIGMA_MARGIN).max(o.k_omega.max(paper));
+        (k, k)
+    };
     // The exact test, once: a round-off at the boundary only ever asks for more.
     for _ in 0..8 {
-        if f_is_positive_definite(&r, o.k_omega, k, &p) {
+        if f_is_positive_definite(&r, k_w, k_s, &p) {
             break;
         }
-        k *= 2.0;
+        (k_w, k_s) = (k_w * 2.0, k_s * 2.0);
     }
-    o.k_sigma = Some(k);
-    Some(format!(
-        "k_sigma = {k}: F of Appendix D (Theorem 1's gain condition) is positive definite iff k_sigma > {threshold:.4e}; generated as max({paper}, {K_SIGMA_MARGIN} × that)"
-    ))
+    (o.k_omega, o.k_sigma) = (k_w, Some(k_s));
+    let threshold = k_sigma_threshold(&[lo, hi], k_w, nu);
+    Some(if paper_ok {
+        format!(
+            "k_sigma = {k_s}, k_omega = {k_w} (the paper's): F of Appendix D (Theorem 1's gain condition) is positive definite iff k_sigma > {threshold:.4e}, and {K_SIGMA_MARGIN} × that <= {paper}"
+        )
+    } else {
+        format!(
+            "k_sigma = k_omega = {k_s:.4}: F of Appendix D (Theorem 1's gain condition) is positive definite iff k_sigma > {threshold:.4e} at this k_omega; the condition is on the product k_sigma·k_omega, so both are raised together to the smallest equal pair with k_sigma >= {K_SIGMA_MARGIN} × that (the paper's {paper} is too small for this graph; docs/stiffness.md)"
+        )
+    })
+}
+
+/// The smallest `k` with `k ≥ margin · k_σ*(k_ω = k)`: per eigenvalue λ of
+/// `Ξ + LLᵀ`, `k λ + ν − margin/(4 k λ) ≥ 0` with `k_σ = k_ω = k`
+/// ([`k_sigma_threshold`] with `k_σ` divided by the margin), i.e.
+/// `k λ = (−ν + √(ν² + margin)) / 2`. For `ν = 0` the condition is
+/// `k_σ k_ω λmin² > 1/4`, a product: `k = √margin / (2 λmin)`.
+fn balanced_gain(spectrum: &[f64], nu: f64, margin: f64) -> f64 {
+    spectrum
+        .iter()
+        .filter(|&&l| l > 0.0)
+        .map(|&l| (-margin * nu + (margin * margin * nu * nu + margin).sqrt()) / (2.0 * l))
+        .fold(0.0, f64::max)
 }
 
 /// Whether `F > 0` (Appendix D) for `k_σ`: the one call of the exact test
@@ -253,9 +295,8 @@ fn f_is_positive_definite(r: &Resolved, k_w: f64, k_sigma: f64, p: &Matrix3<f64>
 /// iff its Schur complement `k_σ F₁ − ½(I ⊗ (P + Pᵀ)) − F₁⁻¹ / (4 k_ω)` is;
 /// its blocks commute, so per eigenvalue λ of `Ξ + LLᵀ` and ν of
 /// `−½(P + Pᵀ)` the condition is `k_σ λ + ν − 1/(4 k_ω λ) > 0`:
-/// `k_σ* = max_λ (1/(4 k_ω λ) − ν_min) / λ` (0 if negative).
-fn k_sigma_threshold(spectrum: &[f64], k_w: f64, p: &Matrix3<f64>) -> f64 {
-    let nu = sym_eigenvalues(&(-(p + p.transpose()) * 0.5))[0];
+/// `k_σ* = max_λ (1/(4 k_ω λ) − ν_min) / λ` (0 if negative), `nu` = `ν_min`.
+fn k_sigma_threshold(spectrum: &[f64], k_w: f64, nu: f64) -> f64 {
     spectrum
         .iter()
         .filter(|&&l| l > 0.0)
@@ -275,6 +316,56 @@ fn pick_dt(s: &mut Scenario) -> Option<String> {
         "dt = {dt} s: the largest stable RK4 step of the linearised loops is {:.3e} s ({} loop, fastest mode {:.3e} 1/s; docs/stiffness.md); generated as {PAPER_DT}/n <= {DT_FRACTION} × that",
         est.dt_max, b.name, b.fastest_rate
     ))
+}
+
+/// The duration when `--duration` is not given, at least, s.
+pub const DEFAULT_DURATION: f64 = 40.0;
+
+/// The estimated time to converge is this multiple of the slowest linear
+/// mode's time to decay by 1e6 (`ln(1e6) / rate`): the linear estimate
+/// ignores the nonlinear transient from large initial errors
+/// (`docs/stiffness.md`, "How long a generated network needs").
+pub const CONVERGE_MULTIPLE: f64 = 4.0;
+
+/// The estimated time for every loop to converge, s:
+/// `CONVERGE_MULTIPLE · ln(1e6) / slowest_rate`, and the loop and rate.
+fn converge_time(s: &Scenario) -> Option<(f64, &'static str, f64)> {
+    let r = crate::scenario::resolve::resolve_with(s, StiffnessCheck::Warn).ok()?;
+    let slow = r.stiffness?.slowest()?.clone();
+    let t = CONVERGE_MULTIPLE * 1e6f64.ln() / slow.slowest_rate;
+    t.is_finite().then_some((t, slow.name, slow.slowest_rate))
+}
+
+/// `simulation.duration`: the given one, with a note and a warning when the
+/// estimate says it is too short to converge; else
+/// `max(DEFAULT_DURATION, the estimate)` rounded up to a whole 10 s (a
+/// whole multiple of every generated `dt`). Returns (note, warning).
+fn pick_duration(s: &mut Scenario, given: Option<f64>) -> (Option<String>, Option<String>) {
+    let Some((t, name, rate)) = converge_time(s) else {
+        return (None, None);
+    };
+    let why = format!(
+        "the slowest linear mode ({name} loop) decays at {rate:.3e} 1/s, so converging needs about {CONVERGE_MULTIPLE} × ln(1e6)/rate = {t:.0} s (docs/stiffness.md)"
+    );
+    match given {
+        Some(d) if d < t => {
+            let w = format!(
+                "duration = {d} s (as given) is shorter than the estimate: {why}; the run may not converge"
+            );
+            (Some(w.clone()), Some(w))
+        }
+        Some(d) => (Some(format!("duration = {d} s (as given): {why}")), None),
+        None => {
+            let d = DEFAULT_DURATION.max((t / 10.0).ceil() * 10.0);
+            s.simulation.duration = d;
+            (
+                Some(format!(
+                    "duration = {d} s: {why}; generated as max({DEFAULT_DURATION}, that) rounded up to 10 s"
+                )),
+                None,
+            )
+        }
+    }
 }
 
 fn constant_leader() -> LeaderSpec {

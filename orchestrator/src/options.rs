@@ -163,7 +163,7 @@ pub fn tree(p: &TreeParams) -> Result<(), OptionError> {
         1,
         u64::from(p.agents),
     )?;
-    positive("--duration", p.duration)
+    p.duration.map_or(Ok(()), |d| positive("--duration", d))
 }
 
 /// `conform`'s `--stage-timeout` and `--start-timeout` (durations).

@@ -59,7 +59,9 @@ fn with_dt(file: &str, set: &[&str], dt: f64, steps: u32) -> Loaded {
 /// RK4 mode grows by a factor > 1 per step: it passes 1e6 within the run).
 fn stays_finite(net: &Network) -> bool {
     let mut ok = true;
-    InProcess::new(net).run(|s| {
+    // The divergence guard stops the run at the first state beyond its
+    // envelope: that is "not finite" here too.
+    let diverged = InProcess::new(net).run(|s| {
         ok = s.agents.iter().all(|a| {
             [a.w, a.w_hat, a.s_hat]
                 .iter()
@@ -68,7 +70,7 @@ fn stays_finite(net: &Network) -> bool {
         });
         ok
     });
-    ok
+    ok && diverged.is_none()
 }
 
 #[test]

@@ -2,8 +2,9 @@
 //! is validated like states (issue 10 item 6).
 //!
 //! An unstable integration (here: the paper's scheme 1 with a huge k_σ,
-//! and the 100-agent tree of `attsync gen tree --seed 1`, which is stiff at
-//! dt = 1 ms) must stop at once in both engines with exit code 3,
+//! and the 100-agent tree of `attsync gen tree --seed 1` with k_σ raised to
+//! 1536 at dt = 1 ms, as the generator once wrote it, run with
+//! `--no-stiffness-check`) must stop at once in both engines with exit code 3,
 //! `complete: false` and the same `diverged { t, node, quantity, value }`;
 //! what was recorded before is kept and byte-identical between the engines,
 //! and no row of `errors.csv` invents an error (no `1` for a NaN state). A
@@ -19,13 +20,20 @@ const DIVERGED: i32 = 3;
 /// Runs `scenario` with both engines, expects both to diverge, asserts the
 /// same results and returns the processes run's summary.
 fn diverges_alike(tmp: &Sandbox, scenario: &Path, sets: &[&str]) -> Value {
+    diverges_alike_with(tmp, scenario, sets, &[])
+}
+
+/// [`diverges_alike`] with more `attsync run` arguments.
+fn diverges_alike_with(tmp: &Sandbox, scenario: &Path, sets: &[&str], more: &[&str]) -> Value {
     let (p, i) = (tmp.join("processes"), tmp.join("in-process"));
     let processes = Attsync::new(tmp.path())
         .args(run_args(scenario, "processes", &p, sets))
+        .args(more.iter().copied())
         .output();
     processes.assert_code(DIVERGED).assert_no_leftovers();
     let in_process = Attsync::new(tmp.path())
         .args(run_args(scenario, "in-process", &i, sets))
+        .args(more.iter().copied())
         .output();
     in_process.assert_code(DIVERGED);
     assert_same_results(&p, &i);
@@ -119,7 +127,32 @@ fn the_generated_100_agent_tree_diverges_alike_in_both_engines() {
         .args(["--out".as_ref(), tree.as_os_str()])
         .output()
         .assert_ok();
-    let s = diverges_alike(&tmp, &tree, &["simulation.duration=2"]);
+    // The generator now picks stable gains and dt; the issue's stiff
+    // version (k_σ raised alone to 1536 at dt = 1 ms) is refused by
+    // validation, naming dt and a step that works …
+    let stiff = [
+        "simulation.duration=2",
+        "scheme.observer.k_sigma=1536",
+        "scheme.observer.k_omega=14",
+    ];
+    let mut check = vec!["check".to_string(), tree.to_string_lossy().into_owned()];
+    for s in &stiff {
+        check.extend(["--set".to_string(), (*s).to_string()]);
+    }
+    let refused = Attsync::new(tmp.path()).args(&check).output();
+    refused.assert_code(2);
+    assert!(
+        refused.stderr.contains("simulation.dt") && refused.stderr.contains("--set simulation.dt="),
+        "{}",
+        refused.describe()
+    );
+    // … and forced past validation it stops as diverged in both engines.
+    let s = diverges_alike_with(&tmp, &tree, &stiff, &["--no-stiffness-check"]);
+    let reason = s["incomplete_reason"].as_str().unwrap_or_default();
+    assert!(
+        reason.contains("probable cause: dt = 0.001 s exceeds the largest stable RK4 step"),
+        "{reason}"
+    );
     assert!(
         s["diverged"]["node"]
             .as_str()

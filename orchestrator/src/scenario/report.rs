@@ -84,7 +84,8 @@ pub fn describe(l: &Loaded) -> String {
 }
 
 /// The step-size estimate (`docs/stiffness.md`): per loop its fastest linear
-/// mode and largest stable RK4 step, then the scenario's and its margin.
+/// mode and largest stable RK4 step, then the scenario's and its margin, and
+/// the slowest error mode (how long the run needs to converge).
 fn stiffness(s: &mut String, e: &Estimate, dt: f64) {
     let _ = writeln!(
         s,
@@ -105,6 +106,15 @@ fn stiffness(s: &mut String, e: &Estimate, dt: f64) {
         seconds(e.dt_max),
         e.dt_max / dt
     );
+    if let Some(l) = e.slowest() {
+        let _ = writeln!(
+            s,
+            "  slowest mode {:.3e} s⁻¹ ({} loop): ln(1e6)/rate = {:.1} s to decay by 1e6",
+            l.slowest_rate,
+            l.name,
+            1e6f64.ln() / l.slowest_rate
+        );
+    }
 }
 
 fn seconds(x: f64) -> String {

@@ -124,7 +124,11 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     let network = assemble::network(parts, &edges, &links);
     // The extremes of Ξ + LLᵀ are all the estimate needs (none without agents).
     let extremes = [spectrum.lambda_min, spectrum.lambda_max];
-    let graph = if network.agents.is_empty() { &[][..] } else { &extremes[..] };
+    let graph = if network.agents.is_empty() {
+        &[][..]
+    } else {
+        &extremes[..]
+    };
     let estimate = stiffness::stiffness(&mut c, &network, graph, check);
     if !c.errors.is_empty() {
         return Err(c.errors);
