@@ -406,6 +406,7 @@ mod tests {
                 name: "observer",
                 fastest_rate: 1.3e4,
                 dt_max: 2.37e-4,
+                slowest_rate: 1.0,
             }],
             dt_max: 2.37e-4,
         };
