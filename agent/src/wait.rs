@@ -18,10 +18,12 @@ use iceoryx2::service::Service;
 use msgs::config::WaitStrategy;
 use std::time::{Duration, Instant};
 
+/// Most yields of an adaptive waiter in one wait before it blocks.
+pub const ADAPTIVE_YIELDS: u32 = 200;
 /// Longest an adaptive waiter yields in one wait before it blocks.
-pub const YIELD_WINDOW: Duration = Duration::from_micros(500);
+pub const YIELD_WINDOW: Duration = Duration::from_millis(2);
 /// A yield that takes longer than this lost the core to another program.
-pub const STOLEN: Duration = Duration::from_micros(250);
+pub const STOLEN: Duration = Duration::from_millis(3);
 /// How long an adaptive waiter blocks at once after a stolen yield.
 pub const CONTENDED_HOLD: Duration = Duration::from_secs(1);
 /// Longest single sleep on the wake event.
@@ -126,7 +128,7 @@ impl Waiter {
             }
             self.contended_until = None;
         }
-        if now.duration_since(self.began) > YIELD_WINDOW {
+        if self.polls > ADAPTIVE_YIELDS || now.duration_since(self.began) > YIELD_WINDOW {
             Step::Block
         } else {
             Step::Yield

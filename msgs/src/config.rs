@@ -21,7 +21,7 @@ pub enum WaitStrategy {
     Yield,
     /// Sleep on the node's wake event (1 ms slices; re-poll after every wake).
     Block,
-    /// Yield for a short while (≤ 0.5 ms), then block; block at once while
+    /// Yield for a short while (≤ 200 polls, 2 ms), then block; block at once while
     /// yields show that another program takes the core.
     Adaptive,
 }

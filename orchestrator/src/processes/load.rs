@@ -23,34 +23,39 @@ fn per_core_ticks() -> Vec<(usize, u64, u64)> {
                 .split_whitespace()
                 .filter_map(|x| x.parse().ok())
                 .collect();
-            // user nice system idle iowait irq softirq steal …
+            // user nice system idle iowait irq softirq steal …: busy is
+            // what ran in this VM (steal — the hypervisor running someone
+            // else's VM — is not a competitor we could avoid by packing).
+            let at = |i: usize| v.get(i).copied().unwrap_or(0);
+            let busy = at(0) + at(1) + at(2) + at(5) + at(6);
             let total: u64 = v.iter().take(8).sum();
-            let idle = v.get(3).copied().unwrap_or(0) + v.get(4).copied().unwrap_or(0);
-            Some((core, total - idle, total))
+            Some((core, busy, total))
         })
         .collect()
 }
 
-/// utime + stime of `pid` (all its threads), ticks.
-fn process_ticks(pid: &str) -> u64 {
-    let Ok(s) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
-        return 0;
-    };
-    // Fields after the command name (which may hold spaces and parentheses).
-    let Some((_, rest)) = s.rsplit_once(')') else {
-        return 0;
-    };
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    // rest[0] is field 3 (state); utime, stime are fields 14, 15.
-    let at = |i: usize| {
-        f.get(i - 3)
-            .and_then(|x| x.parse::<u64>().ok())
-            .unwrap_or(0)
-    };
-    at(14) + at(15)
+/// Time `task` spent on a CPU, ns (`/proc/.../schedstat`: exact, where
+/// `/proc/<pid>/stat`'s utime and stime are cut to 10 ms ticks, an error of
+/// up to a tick per process per sample).
+fn task_ns(task: &std::path::Path) -> u64 {
+    std::fs::read_to_string(task.join("schedstat"))
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0)
 }
 
-/// One sample: per-core (busy, total) and the run's own ticks.
+/// CPU time of every thread of process `pid` (`self` for this one), ns.
+fn process_ns(pid: &str) -> u64 {
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return 0;
+    };
+    tasks.flatten().map(|t| task_ns(&t.path())).sum()
+}
+
+/// Nanoseconds per tick of `/proc/stat` (`USER_HZ`, 100 on Linux).
+const NS_PER_TICK: u64 = 10_000_000;
+
+/// One sample: per-core (busy, total) ticks and the run's own CPU time, ns.
 struct Sample {
     cores: Vec<(usize, u64, u64)>,
     own: u64,
@@ -61,11 +66,7 @@ fn sample(pids: &[u32], allowed: &[usize]) -> Sample {
         .into_iter()
         .filter(|(c, _, _)| allowed.contains(c))
         .collect();
-    let own = pids
-        .iter()
-        .map(|p| process_ticks(&p.to_string()))
-        .sum::<u64>()
-        + process_ticks("self");
+    let own = pids.iter().map(|p| process_ns(&p.to_string())).sum::<u64>() + process_ns("self");
     Sample { cores, own }
 }
 
@@ -80,12 +81,12 @@ fn window(a: &Sample, b: &Sample) -> Window {
         span = span.max(dt);
         per_core.push((core, if dt == 0 { 0.0 } else { db as f64 / dt as f64 }));
     }
-    let foreign = busy.saturating_sub(b.own.saturating_sub(a.own));
+    let foreign = (busy * NS_PER_TICK).saturating_sub(b.own.saturating_sub(a.own));
     Window {
         foreign: if span == 0 {
             0.0
         } else {
-            foreign as f64 / span as f64
+            foreign as f64 / (span * NS_PER_TICK) as f64
         },
         per_core,
     }

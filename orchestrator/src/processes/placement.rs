@@ -41,7 +41,7 @@ pub const QUIET: f64 = 0.25;
 /// Sampling period of the load.
 pub const WINDOW: Duration = Duration::from_millis(200);
 /// The first sampling period (one window decides the first placement).
-pub const FIRST_WINDOW: Duration = Duration::from_millis(100);
+pub const FIRST_WINDOW: Duration = Duration::from_millis(200);
 /// Windows in a row a condition must hold before the placement changes.
 pub const HYSTERESIS: u32 = 2;
 

@@ -125,7 +125,7 @@ pub enum WaitArg {
     Yield,
     /// Sleep on iceoryx2 events (1 ms slices).
     Block,
-    /// Yield a while (≤ 0.5 ms), then block; block at once on a busy machine.
+    /// Yield a while (≤ 200 polls, 2 ms), then block; block at once on a busy machine.
     Adaptive,
 }
 
