@@ -194,7 +194,7 @@ mod tests {
         w.after_yield(t0, t0 + Duration::from_micros(20));
         assert_eq!((w.stolen(), w.adaptive_step(t0)), (0, Step::Yield));
         // A competitor kept the core for a time slice.
-        let back = t0 + Duration::from_millis(3);
+        let back = t0 + STOLEN * 2;
         w.after_yield(t0, back);
         assert_eq!(w.stolen(), 1);
         w.began = back;
