@@ -6,8 +6,12 @@
 //! - a yield that comes back only after [`STOLEN`] shows that another program
 //!   got the core for a time slice (a yield hands the core to whoever is
 //!   runnable, and a CPU-bound competitor keeps it for its whole slice). From
-//!   then on the waiter blocks at once, for [`CONTENDED_HOLD`], and then tries
-//!   yielding again.
+//!   then on the waiter blocks at once, for a hold, and then tries yielding
+//!   again. The first hold is [`HOLD_MIN`]; a probe that is stolen again
+//!   doubles it, up to [`HOLD_MAX`]; a clean probe resets it. A lone hiccup
+//!   of an idle machine (a vCPU descheduled by the hypervisor for a few ms)
+//!   thus costs 20 ms of blocking, not a second, while a lasting competitor
+//!   is probed only about once a second.
 //!
 //! Blocking sleeps on the node's wake event in slices of [`BLOCK_SLICE`] and
 //! the caller re-polls its subscribers after every wake, timeout or not, so
@@ -24,8 +28,10 @@ pub const ADAPTIVE_YIELDS: u32 = 200;
 pub const YIELD_WINDOW: Duration = Duration::from_millis(2);
 /// A yield that takes longer than this lost the core to another program.
 pub const STOLEN: Duration = Duration::from_millis(3);
-/// How long an adaptive waiter blocks at once after a stolen yield.
-pub const CONTENDED_HOLD: Duration = Duration::from_secs(1);
+/// How long an adaptive waiter blocks at once after a first stolen yield.
+pub const HOLD_MIN: Duration = Duration::from_millis(20);
+/// The longest hold: after stolen probes in a row the hold doubles up to this.
+pub const HOLD_MAX: Duration = Duration::from_secs(1);
 /// Longest single sleep on the wake event.
 pub const BLOCK_SLICE: Duration = Duration::from_millis(1);
 
@@ -38,6 +44,10 @@ pub struct Waiter {
     began: Instant,
     /// Adaptive: block at once until then (the cores are shared).
     contended_until: Option<Instant>,
+    /// The current hold: [`HOLD_MIN`] doubled per stolen probe in a row.
+    hold: Duration,
+    /// Whether the next yield is the probe that ends a hold.
+    probing: bool,
     /// Times a yield was stolen (adaptive), for the node's report.
     stolen: u64,
     /// Longest single sleep on the wake event ([`BLOCK_SLICE`]).
@@ -53,6 +63,8 @@ impl Waiter {
             polls: 0,
             began: Instant::now(),
             contended_until: None,
+            hold: HOLD_MIN,
+            probing: false,
             stolen: 0,
             slice: BLOCK_SLICE,
         }
@@ -127,6 +139,7 @@ impl Waiter {
                 return Step::Block;
             }
             self.contended_until = None;
+            self.probing = true;
         }
         if self.polls > ADAPTIVE_YIELDS || now.duration_since(self.began) > YIELD_WINDOW {
             Step::Block
@@ -136,11 +149,20 @@ impl Waiter {
     }
 
     /// Records a yield from `before` to `after`: if it took longer than
-    /// [`STOLEN`], block at once for [`CONTENDED_HOLD`].
+    /// [`STOLEN`], block at once for the hold (doubled if this yield was the
+    /// probe ending the previous hold); a clean probe resets the hold.
     fn after_yield(&mut self, before: Instant, after: Instant) {
+        let probe = std::mem::take(&mut self.probing);
         if after.duration_since(before) > STOLEN {
             self.stolen += 1;
-            self.contended_until = Some(after + CONTENDED_HOLD);
+            self.hold = if probe {
+                (self.hold * 2).min(HOLD_MAX)
+            } else {
+                HOLD_MIN
+            };
+            self.contended_until = Some(after + self.hold);
+        } else if probe {
+            self.hold = HOLD_MIN;
         }
     }
 }
@@ -199,10 +221,44 @@ mod tests {
         assert_eq!(w.stolen(), 1);
         w.began = back;
         assert_eq!(w.adaptive_step(back), Step::Block);
-        assert_eq!(w.adaptive_step(back + CONTENDED_HOLD / 2), Step::Block);
+        assert_eq!(w.adaptive_step(back + HOLD_MIN / 2), Step::Block);
         // After the hold a new episode yields again (a probe).
-        let later = back + CONTENDED_HOLD + Duration::from_millis(1);
+        let later = back + HOLD_MIN + Duration::from_millis(1);
         w.began = later;
         assert_eq!(w.adaptive_step(later), Step::Yield);
+    }
+
+    /// Ends the current hold at `at` with a probe that takes `took`; returns
+    /// the hold that follows (zero: none).
+    fn probe(w: &mut Waiter, at: Instant, took: Duration) -> Duration {
+        let until = w.contended_until.expect("in a hold");
+        assert!(at >= until);
+        w.began = at;
+        assert_eq!(w.adaptive_step(at), Step::Yield);
+        w.after_yield(at, at + took);
+        w.contended_until
+            .map_or(Duration::ZERO, |u| u.duration_since(at + took))
+    }
+
+    #[test]
+    fn stolen_probes_in_a_row_double_the_hold_up_to_the_max_and_a_clean_one_resets_it() {
+        let t0 = Instant::now();
+        let mut w = adaptive(t0);
+        let stolen = STOLEN * 2;
+        w.after_yield(t0, t0 + stolen);
+        let mut at = t0 + stolen;
+        let mut expected = HOLD_MIN;
+        for _ in 0..10 {
+            at += expected;
+            expected = (expected * 2).min(HOLD_MAX);
+            assert_eq!(probe(&mut w, at, stolen), expected);
+            at += stolen;
+        }
+        assert_eq!(expected, HOLD_MAX);
+        // A clean probe: no hold, and the next stolen yield starts again at the minimum.
+        at += expected;
+        assert_eq!(probe(&mut w, at, Duration::from_micros(10)), Duration::ZERO);
+        w.after_yield(at, at + stolen);
+        assert_eq!(w.contended_until, Some(at + stolen + HOLD_MIN));
     }
 }

@@ -23,13 +23,15 @@ pub(super) struct ContendRow {
     pub ring_loaded: BareAgg,
 }
 
-/// Steps of a contended run: strategies that poll (yield, spin) lose a
-/// whole time slice per poll to a competitor, so they get a tenth.
+/// Steps of a contended run: strategies that poll lose a whole time slice
+/// per poll to a competitor, so yield gets a tenth and spin (which also
+/// loses a slice whenever more nodes than cores spin) a hundredth.
 pub(super) fn steps(plan: &Plan, case: &Case, wait: WaitStrategy) -> u64 {
     let base = plan.contend_steps.min(case.steps);
     match wait {
         WaitStrategy::Adaptive | WaitStrategy::Block => base,
-        WaitStrategy::Yield | WaitStrategy::Spin => (base / 10).max(1),
+        WaitStrategy::Yield => (base / 10).max(1),
+        WaitStrategy::Spin => (base / 100).max(1),
     }
 }
 

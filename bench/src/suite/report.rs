@@ -346,7 +346,7 @@ fn contended(w: &mut String, res: &Results, cx: &Context, notes: &mut Vec<String
     }
     let _ = writeln!(
         w,
-        "\nEach strategy is measured idle and loaded at the same number of steps (yield and spin at a tenth: \
+        "\nEach strategy is measured idle and loaded at the same number of steps (yield at a tenth, spin at a hundredth: \
          each of their polls can hand a whole time slice to a competitor); \"loaded ÷ idle\" is the slow-down the \
          competitors cause (the fair share of 2 cores shared with {} CPU-bound programs is about 2×).",
         cx.cores
