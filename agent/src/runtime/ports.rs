@@ -151,12 +151,22 @@ impl<S: Service> Ports<S> {
         }
     }
 
-    /// Sends a telemetry report of node `id` and wakes the orchestrator.
+    /// Sends a telemetry report of node `id`; an event (anything but a
+    /// sample) also wakes the orchestrator.
+    ///
+    /// NOTE: samples are not notified. The orchestrator drains its telemetry
+    /// at least every 10 ms anyway (its wait's timeout) and its buffer holds
+    /// 256 reports per node; a wake-up per sample and node (32 000 in the
+    /// paper run) put the orchestrator on a core the nodes needed — the
+    /// benchmark measured 20.1 µs per exchange with samples against 14.5 µs
+    /// without.
     pub fn report(&self, id: u32, t: &Telemetry) -> Result<(), NodeError> {
         self.tele_pub
             .send_copy(TelemetryMsg::encode(id, t))
             .map_err(port("telemetry send"))?;
-        let _ = self.orch_notifier.notify();
+        if !matches!(t, Telemetry::Sample { .. } | Telemetry::LeaderSample { .. }) {
+            let _ = self.orch_notifier.notify();
+        }
         Ok(())
     }
 
