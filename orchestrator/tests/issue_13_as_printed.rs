@@ -7,15 +7,16 @@
 //! not vanish while the reference rotates, so the paper's experiment
 //! (`scenarios/paper/timevarying.toml`) stalls instead of converging. The
 //! tests run it for the paper's 40 s in-process and check:
-//! - the printed law stalls: the largest final `|Rᵢ R₀ᵀ|_I` is between
+//! - the printed law stalls: every agent's final `|Rᵢ R₀ᵀ|_I` is between
 //!   [`STALL_LOW`] and [`STALL_HIGH`], while the corrected law ends below
 //!   [`CONVERGED`];
 //! - an independent reference, written here from the paper's equations
 //!   (classical RK4 on unit quaternions, renormalised every step; not
 //!   attsync's RKMK4 on rotation matrices, nor its `so3`, observer or
 //!   control code), built from the paper's numbers (not the scenario file),
-//!   agrees: its printed-law run stalls in the same band and within a factor
-//!   [`SAME_ORDER`] of attsync's, and its corrected-law run converges;
+//!   agrees: its printed-law run stalls in the same band, agent by agent
+//!   within a factor [`SAME_ORDER`] of attsync's (and within
+//!   [`SAME_CURVE`] relative), and its corrected-law run converges;
 //! - scheme 2, whose law takes `Γᵢ` from eq. `gammai` too, runs the printed
 //!   `Γᵢ`: the run differs from the corrected one, but its residual
 //!   `−2 vᵢ × Jᵢ vᵢ` fades with the observer's `ω̂ᵢ → 0`, so it still
@@ -30,14 +31,22 @@ use nalgebra::{Matrix3, Vector3, Vector4};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
-/// The printed law's largest final attitude error is at least this.
+/// Under the printed law every agent's final attitude error is at least
+/// this: measured 5.7e-3 (agent 7) to 8.7e-3 (agent 1), in attsync and in
+/// the reference alike (an independent integration elsewhere: 6e-3–9e-3),
+/// so a factor 5 of margin.
 const STALL_LOW: f64 = 1e-3;
-/// … and at most this.
+/// … and at most this (a factor 5 above the largest measured).
 const STALL_HIGH: f64 = 5e-2;
-/// The corrected law's largest final attitude error is below this.
+/// The corrected law's largest final attitude error is below this:
+/// measured 1.1e-8 (attsync and the reference).
 const CONVERGED: f64 = 1e-4;
-/// attsync's and the reference's stalled errors are within this factor.
+/// attsync's and the reference's stalled errors, agent by agent, are within
+/// this factor ("the same order of magnitude")…
 const SAME_ORDER: f64 = 3.0;
+/// … and, closer, within this relative difference: both are 4th-order
+/// integrations of one closed loop at dt = 1 ms (measured: 5.9e-10).
+const SAME_CURVE: f64 = 1e-6;
 
 fn scenario(name: &str, set: &[&str]) -> Loaded {
     let file = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -76,16 +85,13 @@ const PRINTED: &str = "scheme.law=\"as-printed\"";
 fn scheme_1_stalls_under_the_printed_law_and_converges_under_the_corrected_one() {
     let (printed, _) = final_errors(&scenario("timevarying.toml", &[PRINTED]));
     let (corrected, _) = final_errors(&scenario("timevarying.toml", &[]));
-    let (p, c) = (max(&printed), max(&corrected));
+    let c = max(&corrected);
     eprintln!(
         "scheme 1 at 40 s: printed {}, corrected {}",
         sci(&printed),
         sci(&corrected)
     );
-    assert!(
-        (STALL_LOW..=STALL_HIGH).contains(&p),
-        "printed law: largest final att_err {p:e}, per agent {printed:?}"
-    );
+    assert_stalls("attsync", &printed);
     assert!(c < CONVERGED, "corrected law: largest final att_err {c:e}");
 }
 
@@ -94,22 +100,41 @@ fn an_independent_rk4_of_the_printed_law_stalls_alike() {
     let (attsync, _) = final_errors(&scenario("timevarying.toml", &[PRINTED]));
     let printed = reference::final_att_errors(reference::Law::AsPrinted);
     let corrected = reference::final_att_errors(reference::Law::Corrected);
-    let (a, p, c) = (max(&attsync), max(&printed), max(&corrected));
+    let c = max(&corrected);
     eprintln!(
         "reference at 40 s: printed {}, corrected {}",
         sci(&printed),
         sci(&corrected)
     );
     eprintln!("attsync printed {}", sci(&attsync));
-    assert!(
-        (STALL_LOW..=STALL_HIGH).contains(&p),
-        "reference, printed law: {printed:?}"
-    );
+    assert_stalls("reference", &printed);
     assert!(c < CONVERGED, "reference, corrected law: {corrected:?}");
+    let mut worst: f64 = 0.0;
+    for (k, (a, p)) in attsync.iter().zip(&printed).enumerate() {
+        assert!(
+            a / p < SAME_ORDER && p / a < SAME_ORDER,
+            "agent {}: attsync {a:e} against the reference {p:e}",
+            k + 1
+        );
+        worst = worst.max((a - p).abs() / p);
+    }
+    eprintln!("largest relative difference attsync / reference: {worst:.1e}");
     assert!(
-        a / p < SAME_ORDER && p / a < SAME_ORDER,
-        "attsync {a:e} against the reference {p:e}"
+        worst < SAME_CURVE,
+        "attsync {attsync:?}, reference {printed:?}"
     );
+}
+
+/// Every agent of `what` stalled: its final error in `[STALL_LOW, STALL_HIGH]`.
+#[track_caller]
+fn assert_stalls(what: &str, errors: &[f64]) {
+    for (k, e) in errors.iter().enumerate() {
+        assert!(
+            (STALL_LOW..=STALL_HIGH).contains(e),
+            "{what}, printed law: agent {} ends at att_err {e:e} (all: {errors:?})",
+            k + 1
+        );
+    }
 }
 
 #[test]

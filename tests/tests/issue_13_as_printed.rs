@@ -121,6 +121,14 @@ fn run_warns_and_check_shows_the_law() {
         r.describe()
     );
     assert_warns(&r.stdout, &r);
+    check.extend(os(&["--node-config", "1"]));
+    let r = attsync(&tmp, &check);
+    r.assert_ok();
+    assert!(
+        r.stdout.contains("\"law\": \"as-printed\""),
+        "{}",
+        r.describe()
+    );
 }
 
 #[test]
