@@ -12,9 +12,7 @@
 //! values, an agent computes bit-identical results in any process.
 
 use crate::body::omega_dot;
-use crate::control::{
-    tau_control, tau_control_constant_estimate, tau_districontrol, tracking_error,
-};
+use crate::control::{tau_districontrol, tracking_error};
 use crate::integrate::{LieDerivative, LieState, Rkmk4};
 use crate::link::{Link, LinkModel, LinkStats};
 use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
@@ -27,8 +25,10 @@ use nalgebra::{Matrix3, Vector3};
 ///
 /// Scheme 1: eqs. `followeri`, `7a`–`7c`, `control`. Scheme 2: eqs.
 /// `followeri`, `16a`–`16b`, `controlconstantestimate`. Scheme 3: eqs.
-/// `followeri`, `districontrol`. `nbrs` are in the order of
-/// `model.neighbours`; `leader` is `Some` iff the agent hears the leader.
+/// `followeri`, `districontrol`. Schemes 1–2 take `Σᵢ`, `Γᵢ` as
+/// `model.law` says (corrected, or as printed: the negative control).
+/// `nbrs` are in the order of `model.neighbours`; `leader` is `Some` iff
+/// the agent hears the leader.
 #[must_use]
 pub fn agent_field(
     model: &AgentModel,
@@ -47,13 +47,15 @@ pub fn agent_field(
             let w_hat_dot = omega_hat_dot_7b(observer, &own, gains, nbrs, leader);
             let s_hat_dot = sigma_hat_dot_7c(observer, &model.p, &own, nbrs, leader);
             let e = tracking_error(&x.r, &x.w, &x.r_hat, &x.w_hat);
-            let tau = tau_control(control, &model.inertia, &model.a_bar, &e, &w_hat_dot);
+            let tau = model
+                .law
+                .tau_control(control, &model.inertia, &model.a_bar, &e, &w_hat_dot);
             (w_hat_dot, s_hat_dot, tau)
         }
         Scheme::ObserverConstant { observer, control } => {
             let w_hat_dot = omega_hat_dot_16b(observer, &own, gains, nbrs, leader);
             let e = tracking_error(&x.r, &x.w, &x.r_hat, &x.w_hat);
-            let tau = tau_control_constant_estimate(
+            let tau = model.law.tau_control_constant_estimate(
                 control,
                 &model.inertia,
                 &model.a_bar,

@@ -1,5 +1,8 @@
 //! Control laws: eq. `control` (with the corrected `sigmai`, `gammai`),
-//! eq. `controlconstantestimate` and eq. `districontrol`.
+//! eq. `controlconstantestimate` and eq. `districontrol`; and, as a negative
+//! control selected by [`ControlLaw::AsPrinted`], the observer-based laws
+//! with `Σᵢ`, `Γᵢ` exactly as the paper prints them (erratum 1 of
+//! `docs/paper.md`).
 
 use crate::body::Inertia;
 use crate::network::Exchanged;
@@ -77,8 +80,14 @@ pub fn gamma_i(inertia: &Inertia, e: &TrackingError, w_hat_dot: &Vector3<f64>) -
     -e.v.cross(&(j * e.v)) - j * (e.r_bar.transpose() * w_hat_dot)
 }
 
-/// `Σᵢ` exactly as printed in the paper (wrong sign on `(Jᵢvᵢ)^×`). Kept only
-/// so that a test can show it violates eq. `controlerror1`.
+/// `Σᵢ` exactly as printed in the paper (wrong sign on `(Jᵢvᵢ)^×`): it
+/// violates eq. `controlerror1` (shown by a test), and is run only by
+/// [`ControlLaw::AsPrinted`], the negative control.
+///
+/// # Equation
+/// ```text
+/// (sigmai, as printed)  Σᵢ = (Jᵢ ω̄ᵢ)^× − (Jᵢ vᵢ)^× − vᵢ^× Jᵢ − Jᵢ vᵢ^×
+/// ```
 #[must_use]
 pub fn sigma_i_as_printed(inertia: &Inertia, e: &TrackingError) -> Matrix3<f64> {
     let j = &inertia.j;
@@ -86,8 +95,13 @@ pub fn sigma_i_as_printed(inertia: &Inertia, e: &TrackingError) -> Matrix3<f64> 
     hat(&(j * e.w_bar)) - hat(&(j * e.v)) - hv * j - j * hv
 }
 
-/// `Γᵢ` exactly as printed in the paper (wrong sign on `vᵢ × Jᵢvᵢ`). Kept
-/// only so that a test can show it violates eq. `controlerror1`.
+/// `Γᵢ` exactly as printed in the paper (wrong sign on `vᵢ × Jᵢvᵢ`): see
+/// [`sigma_i_as_printed`].
+///
+/// # Equation
+/// ```text
+/// (gammai, as printed)  Γᵢ = vᵢ × Jᵢ vᵢ − Jᵢ R̄ᵢᵀ dω̂ᵢ/dt
+/// ```
 #[must_use]
 pub fn gamma_i_as_printed(
     inertia: &Inertia,
@@ -133,6 +147,123 @@ pub fn tau_control_constant_estimate(
     w_hat_dot: &Vector3<f64>,
 ) -> Vector3<f64> {
     -gamma_i(inertia, e, w_hat_dot) - pd(g, a_bar, e)
+}
+
+/// Eq. `control` with `Σᵢ`, `Γᵢ` as printed ([`sigma_i_as_printed`],
+/// [`gamma_i_as_printed`]): the negative control of scheme 1.
+///
+/// # Equation
+/// ```text
+/// (control, as printed)  τᵢ = −Σᵢ ω̄ᵢ − Γᵢ − k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ
+/// ```
+/// # NOTE
+/// Known wrong (erratum 1 of `docs/paper.md`): the tracking error obeys
+/// `Jᵢ dω̄ᵢ/dt = −k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ − 2 ωᵢ × Jᵢ vᵢ` instead of eq.
+/// `controlerror2`, and the residual does not vanish while the reference
+/// rotates: the paper's scheme-1 experiment stalls near 1e-2.
+#[must_use]
+pub fn tau_control_as_printed(
+    g: &ControlGains,
+    inertia: &Inertia,
+    a_bar: &Matrix3<f64>,
+    e: &TrackingError,
+    w_hat_dot: &Vector3<f64>,
+) -> Vector3<f64> {
+    -sigma_i_as_printed(inertia, e) * e.w_bar
+        - gamma_i_as_printed(inertia, e, w_hat_dot)
+        - pd(g, a_bar, e)
+}
+
+/// Eq. `controlconstantestimate` with `Γᵢ` as printed
+/// ([`gamma_i_as_printed`]; the paper defines scheme 2's `Γᵢ` by eq.
+/// `gammai`): the negative control of scheme 2.
+///
+/// # Equation
+/// ```text
+/// (controlconstantestimate, as printed)  τᵢ = −Γᵢ − k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ
+/// ```
+/// # NOTE
+/// The tracking error gains `−2 vᵢ × Jᵢ vᵢ` over the corrected law; with a
+/// constant reference the observer's `ω̂ᵢ → 0`, so `vᵢ → 0` and the
+/// residual fades: unlike scheme 1, this one still converges.
+#[must_use]
+pub fn tau_control_constant_estimate_as_printed(
+    g: &ControlGains,
+    inertia: &Inertia,
+    a_bar: &Matrix3<f64>,
+    e: &TrackingError,
+    w_hat_dot: &Vector3<f64>,
+) -> Vector3<f64> {
+    -gamma_i_as_printed(inertia, e, w_hat_dot) - pd(g, a_bar, e)
+}
+
+/// Which signs of `Σᵢ` (eq. `sigmai`) and `Γᵢ` (eq. `gammai`) the
+/// observer-based laws (schemes 1–2) use; scheme 3's `districontrol` has
+/// neither. Scenario key `scheme.law`, carried in every `AgentModel`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ControlLaw {
+    /// The signs derived from the plant (erratum 1 of `docs/paper.md`):
+    /// eq. `control` gives eq. `controlerror2` exactly.
+    #[default]
+    Corrected,
+    /// The signs as the paper prints them, known wrong: a negative control
+    /// (scheme 1 stalls instead of converging).
+    AsPrinted,
+}
+
+impl ControlLaw {
+    /// Whether this is the default, [`ControlLaw::Corrected`] (then it is not
+    /// written out).
+    #[must_use]
+    pub fn is_corrected(&self) -> bool {
+        *self == ControlLaw::Corrected
+    }
+
+    /// The name as written in scenario files and configurations.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            ControlLaw::Corrected => "corrected",
+            ControlLaw::AsPrinted => "as-printed",
+        }
+    }
+
+    /// Scheme 1's torque under this law: [`tau_control`] or
+    /// [`tau_control_as_printed`].
+    #[must_use]
+    pub fn tau_control(
+        self,
+        g: &ControlGains,
+        inertia: &Inertia,
+        a_bar: &Matrix3<f64>,
+        e: &TrackingError,
+        w_hat_dot: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        match self {
+            ControlLaw::Corrected => tau_control(g, inertia, a_bar, e, w_hat_dot),
+            ControlLaw::AsPrinted => tau_control_as_printed(g, inertia, a_bar, e, w_hat_dot),
+        }
+    }
+
+    /// Scheme 2's torque under this law: [`tau_control_constant_estimate`]
+    /// or [`tau_control_constant_estimate_as_printed`].
+    #[must_use]
+    pub fn tau_control_constant_estimate(
+        self,
+        g: &ControlGains,
+        inertia: &Inertia,
+        a_bar: &Matrix3<f64>,
+        e: &TrackingError,
+        w_hat_dot: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        match self {
+            ControlLaw::Corrected => tau_control_constant_estimate(g, inertia, a_bar, e, w_hat_dot),
+            ControlLaw::AsPrinted => {
+                tau_control_constant_estimate_as_printed(g, inertia, a_bar, e, w_hat_dot)
+            }
+        }
+    }
 }
 
 /// `k_R̄ ψ(Āᵢ R̄ᵢ) + k_ω̄ ω̄ᵢ`, the part shared by both observer-based laws.

@@ -14,7 +14,8 @@
 //! - [`mod@reference`]: the leader (eq. `leader`).
 //! - [`observer`]: eqs. `7a`–`7c`, `16a`–`16b`.
 //! - [`control`]: eqs. `control` (corrected `sigmai`, `gammai`),
-//!   `controlconstantestimate`, `districontrol`.
+//!   `controlconstantestimate`, `districontrol`; the printed `sigmai`,
+//!   `gammai` as a negative control ([`control::ControlLaw`]).
 //! - [`network`]: the resolved network every engine runs.
 //! - [`link`]: delay, jitter, loss and per-link period, on the receiving side.
 //! - [`agent`]: one follower as a stage-by-stage stepper (the exchange protocol).

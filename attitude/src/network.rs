@@ -5,7 +5,7 @@
 //! matrices, neighbours sorted by id). Every engine builds its nodes from it.
 
 use crate::body::Inertia;
-use crate::control::ControlGains;
+use crate::control::{ControlGains, ControlLaw};
 use crate::link::LinkModel;
 use crate::observer::ObserverGains;
 use crate::reference::LeaderState;
@@ -166,6 +166,10 @@ pub struct AgentModel {
     pub scheme: Scheme,
     /// The leader's generator `P` (known to every observer, eq. `7c`).
     pub p: Matrix3<f64>,
+    /// The signs of `Σᵢ`, `Γᵢ` in the law of schemes 1–2 (the same for every
+    /// agent; absent: corrected, and then not written).
+    #[serde(default, skip_serializing_if = "ControlLaw::is_corrected")]
+    pub law: ControlLaw,
 }
 
 /// How often neighbours exchange states.

@@ -541,6 +541,7 @@ fn network(observerless: bool, links: Links, steps: u64) -> Network {
                 leader_link: lead.and_then(|x| x.1),
                 scheme: scheme(observerless),
                 p,
+                law: Default::default(),
             },
             initial: AgentState {
                 r,

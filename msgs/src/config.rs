@@ -2,6 +2,9 @@
 //! (`--config FILE`), written by the orchestrator. f64 values round-trip
 //! exactly (shortest representation, parsed with correct rounding), so a
 //! node computes bit-identical results to the in-process engine.
+//!
+//! An agent's law travels in its model: `role.model.law` (`"as-printed"`
+//! for the negative control of erratum 1; absent: `"corrected"`).
 
 use crate::open::Limits;
 use attitude::guard::Envelope;
@@ -157,4 +160,105 @@ pub enum ConfigError {
         /// The operating system's reason.
         cause: String,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use attitude::body::Inertia;
+    use attitude::control::{ControlGains, ControlLaw};
+    use attitude::network::{Neighbour, Scheme};
+    use attitude::observer::ObserverGains;
+    use nalgebra::Vector3;
+
+    /// An agent's configuration under `law`, with values that need all 17
+    /// digits (0.1, π/7, 1/3).
+    fn config(law: ControlLaw) -> NodeConfig {
+        let third = 1.0 / 3.0;
+        let model = AgentModel {
+            id: 2,
+            inertia: Inertia::new(Matrix3::from_diagonal(&Vector3::new(0.1, 0.3, third))),
+            a_bar: Matrix3::from_diagonal(&Vector3::new(11.0, 12.0, 13.0)),
+            neighbours: vec![Neighbour {
+                id: 1,
+                a: Matrix3::from_diagonal(&Vector3::new(12.0, 13.0, 14.0)),
+                link: None,
+            }],
+            leader_gain: Some(Matrix3::from_diagonal(&Vector3::new(16.0, 17.0, 18.0))),
+            leader_link: None,
+            scheme: Scheme::ObserverTimeVarying {
+                observer: ObserverGains {
+                    k_r: 9.0,
+                    k_w: 14.0,
+                    k_sigma: 12.0,
+                },
+                control: ControlGains {
+                    k_r: 8.0,
+                    k_w: 13.0,
+                },
+            },
+            p: Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.0, -0.7, 0.0, 0.7, 0.0),
+            law,
+        };
+        let r = attitude::so3::rot(std::f64::consts::PI / 7.0, &Vector3::new(0.6, 0.8, 0.0));
+        NodeConfig {
+            protocol_version: crate::PROTOCOL_VERSION,
+            run: "RUN".into(),
+            iox_root: "/tmp/attsync-iox2/RUN".into(),
+            id: 2,
+            dt: 0.001,
+            steps: 40_000,
+            coupling: Coupling::Continuous,
+            sample_every: 10,
+            inputs: vec![1, 0],
+            outputs: vec![1],
+            limits: Limits {
+                nodes: 3,
+                max_fanout: 1,
+                state_buffer: 64,
+                telemetry_buffer: 64,
+            },
+            wait: WaitStrategy::Adaptive,
+            stage_timeout: 5.0,
+            start_timeout: 30.0,
+            realtime: None,
+            guard: Envelope::default(),
+            role: Role::Agent {
+                model: Box::new(model),
+                initial: AgentState {
+                    r,
+                    w: Vector3::new(2.5, 2.0, third),
+                    r_hat: r.transpose(),
+                    w_hat: Vector3::new(0.1, 0.2, 0.3),
+                    s_hat: Vector3::new(3.0, 2.5, 2.0),
+                },
+            },
+        }
+    }
+
+    #[test]
+    fn the_printed_law_round_trips_exactly() {
+        let cfg = config(ControlLaw::AsPrinted);
+        let text = serde_json::to_string_pretty(&cfg).unwrap();
+        assert!(text.contains("\"law\": \"as-printed\""), "{text}");
+        let back: NodeConfig = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, cfg);
+    }
+
+    #[test]
+    fn the_corrected_law_is_not_written_and_is_the_default() {
+        let cfg = config(ControlLaw::Corrected);
+        let text = serde_json::to_string_pretty(&cfg).unwrap();
+        assert!(!text.contains("\"law\""), "{text}");
+        let back: NodeConfig = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, cfg);
+    }
+
+    #[test]
+    fn an_unknown_law_is_refused() {
+        let text = serde_json::to_string(&config(ControlLaw::AsPrinted)).unwrap();
+        let bad = text.replace("\"as-printed\"", "\"as-typed\"");
+        let e = serde_json::from_str::<NodeConfig>(&bad).unwrap_err();
+        assert!(e.to_string().contains("as-typed"), "{e}");
+    }
 }

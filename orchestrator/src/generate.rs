@@ -179,6 +179,7 @@ fn paper_scheme_and_leader(kind: SchemeKind) -> (SchemeSpec, LeaderSpec) {
         kind,
         observer,
         control: ControlGainsSpec { k_r, k_omega },
+        law: Default::default(),
     };
     match kind {
         SchemeKind::ObserverTimeVarying => (

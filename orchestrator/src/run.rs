@@ -239,6 +239,7 @@ fn summarise(
         attsync_version: env!("CARGO_PKG_VERSION").into(),
         scenario: loaded.name(),
         engine: opts.engine.name().into(),
+        law: loaded.scenario.scheme.law,
         complete: outcome.failure.is_none() && outcome.diverged.is_none() && steps == net.steps,
         incomplete_reason: outcome.failure,
         diverged: outcome.diverged.map(|d| Diverged::of(&d, net.dt)),

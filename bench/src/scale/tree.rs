@@ -103,6 +103,7 @@ pub fn network(n: u32, scheme: SchemeArg, steps: u64) -> Network {
                 leader_link: None,
                 scheme: scheme.scheme(),
                 p,
+                law: Default::default(),
             };
             let r = rot(0.1 + 0.01 * k, &axis);
             let initial = AgentState {

@@ -229,6 +229,7 @@ mod tests {
                 control: ControlGains { k_r: 1.9, k_w: 1.9 },
             },
             p: Matrix3::zeros(),
+            law: Default::default(),
         };
         let initial = AgentState {
             r: rot(0.3 * std::f64::consts::PI, &u2),

@@ -14,10 +14,16 @@
 //! estimate `(R̂, ω̂, σ̂)`, for scheme 3 the body `(R, ω, 0)`); the samples
 //! show the whole state, so a wrong body law under an observer scheme is
 //! caught too.
+//!
+//! The shadow is built from the candidate's own `AgentModel`, so it follows
+//! the configured `law` (`scheme.law`): under `"as-printed"` the candidate
+//! must run the paper's printed `Σᵢ`, `Γᵢ` (the negative control), and the
+//! corrected law deviates.
 
 use super::LawMode;
 use super::rules::{Report, RuleId};
 use attitude::agent::Agent;
+use attitude::control::ControlLaw;
 use attitude::network::{AgentModel, AgentState, Exchanged, Scheme};
 use attitude::schedule::Schedule;
 use msgs::config::{NodeConfig, Role};
@@ -292,8 +298,12 @@ pub(super) fn judge(cfg: &NodeConfig, record: &LawRecord, mode: LawMode, report:
         Ok(None) => report.not_checked(RuleId::Law, "nothing was recorded to compare"),
         Ok(Some(d)) if d.value <= TOLERANCE => report.pass(RuleId::Law),
         Ok(Some(d)) => {
+            let law = match model.law {
+                ControlLaw::Corrected => String::new(),
+                other => format!(" ({})", other.name()),
+            };
             let why = format!(
-                "differs from the built-in scheme-{n} law by {:.1e} ({} at {})",
+                "differs from the built-in scheme-{n} law{law} by {:.1e} ({} at {})",
                 d.value, d.quantity, d.at
             );
             match mode {
@@ -350,7 +360,12 @@ mod tests {
     }
 
     fn setup() -> (AgentModel, AgentState, f64, Schedule, Vec<Exchanged>) {
-        let net = network();
+        setup_of(network())
+    }
+
+    /// Agent 2 of `net` (which hears the leader) with its neighbours' and
+    /// the leader's initial values as constant inputs.
+    fn setup_of(net: Network) -> (AgentModel, AgentState, f64, Schedule, Vec<Exchanged>) {
         let a = &net.agents[1];
         let nbrs = net.neighbour_indices();
         let mut inputs: Vec<Exchanged> = nbrs[1]
@@ -398,5 +413,38 @@ mod tests {
         rec.exchanges.remove(1);
         let e = replay(&model, initial, dt, schedule, &rec).unwrap_err();
         assert!(matches!(e, LawError::OutOfSchedule { .. }), "{e}");
+    }
+
+    /// Scheme 1's conformance neighbourhood under `scheme.law = law`.
+    fn timevarying(law: &str) -> Network {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../scenarios/plugin/conform-timevarying.toml");
+        let set = [
+            "simulation.duration=0.02".into(),
+            format!("scheme.law=\"{law}\""),
+        ];
+        crate::scenario::load(&file, &set)
+            .expect("the scheme-1 neighbourhood loads")
+            .resolved
+            .network
+    }
+
+    #[test]
+    fn the_shadow_follows_the_configured_law() {
+        let (model, initial, dt, schedule, inputs) = setup_of(timevarying("as-printed"));
+        assert_eq!(model.law, ControlLaw::AsPrinted);
+        let mut printed = Agent::new(model.clone(), initial, dt);
+        let rec = record_of(&mut printed, schedule, &inputs);
+        let d = replay(&model, initial, dt, schedule, &rec);
+        assert_eq!(d.unwrap().unwrap().value, 0.0);
+        let corrected = AgentModel {
+            law: ControlLaw::Corrected,
+            ..model.clone()
+        };
+        let mut agent = Agent::new(corrected, initial, dt);
+        let rec = record_of(&mut agent, schedule, &inputs);
+        let d = replay(&model, initial, dt, schedule, &rec);
+        let d = d.unwrap().unwrap();
+        assert!(d.value > 1e-6, "{d:?}");
     }
 }

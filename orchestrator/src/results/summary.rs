@@ -74,6 +74,10 @@ pub struct Summary {
     pub scenario: String,
     /// Engine used.
     pub engine: String,
+    /// `scheme.law`: `corrected`, or `as-printed` (the negative control of
+    /// erratum 1); absent in summaries written before it existed: corrected.
+    #[serde(default)]
+    pub law: attitude::control::ControlLaw,
     /// Whether the run reached its horizon.
     pub complete: bool,
     /// Why not, if not.

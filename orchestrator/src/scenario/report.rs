@@ -2,6 +2,7 @@
 
 use super::Loaded;
 use super::resolve::kind_name;
+use attitude::control::ControlLaw;
 use attitude::network::Coupling;
 use attitude::stiffness::Estimate;
 use std::fmt::Write as _;
@@ -15,6 +16,7 @@ pub fn describe(l: &Loaded) -> String {
     let _ = writeln!(s, "{}: OK", l.file.display());
     let _ = writeln!(s, "name:      {}", l.name());
     let _ = writeln!(s, "scheme:    {}", kind_name(l.scenario.scheme.kind));
+    let _ = writeln!(s, "law:       {}", law(l.scenario.scheme.law));
     let coupling = match n.coupling {
         Coupling::Continuous => "continuous (exchange at every stage)".to_string(),
         Coupling::Sampled { every } => {
@@ -122,5 +124,15 @@ fn seconds(x: f64) -> String {
         format!("{x:.3e} s")
     } else {
         "unlimited".into()
+    }
+}
+
+/// `scheme.law` as `check` shows it.
+fn law(law: ControlLaw) -> String {
+    match law {
+        ControlLaw::Corrected => "corrected".into(),
+        ControlLaw::AsPrinted => {
+            "as-printed (the paper's printed Σᵢ, Γᵢ, known wrong: a negative control)".into()
+        }
     }
 }

@@ -1,6 +1,7 @@
 //! The scenario file format (TOML), as serde types. Unknown keys are
 //! rejected everywhere. See README.md § Scenario format.
 
+use attitude::control::ControlLaw;
 use serde::{Deserialize, Serialize};
 
 /// A whole scenario file.
@@ -208,6 +209,11 @@ pub struct SchemeSpec {
     pub observer: Option<ObserverGainsSpec>,
     /// Control gains.
     pub control: ControlGainsSpec,
+    /// `"corrected"` (the default) or `"as-printed"`: the signs of `Σᵢ`,
+    /// `Γᵢ` as the paper prints them (erratum 1 of `docs/paper.md`), a
+    /// negative control for the observer schemes.
+    #[serde(default, skip_serializing_if = "ControlLaw::is_corrected")]
+    pub law: ControlLaw,
 }
 
 /// `scheme.kind`.

@@ -5,6 +5,7 @@ use super::agents::Body;
 use super::graph::{Edges, LeaderLinks};
 use super::leader::Leader;
 use super::simulation::Timing;
+use attitude::control::ControlLaw;
 use attitude::guard::Envelope;
 use attitude::link::LinkModel;
 use attitude::network::{AgentModel, AgentSpec, Neighbour, Network, Scheme};
@@ -19,6 +20,7 @@ pub(super) struct Parts {
     pub(super) bodies: BTreeMap<u32, Body>,
     pub(super) impaired: BTreeMap<(u32, u32), LinkModel>,
     pub(super) guard: Envelope,
+    pub(super) law: ControlLaw,
 }
 
 /// The network of `parts` over `edges` and `links`.
@@ -33,6 +35,7 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
         bodies,
         impaired,
         guard,
+        law,
     } = parts;
     let scheme = scheme.expect("no errors");
     let p = leader.p;
@@ -54,6 +57,7 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
                 leader_link: impaired.get(&(0, id)).copied(),
                 scheme,
                 p,
+                law,
             },
             initial,
         })

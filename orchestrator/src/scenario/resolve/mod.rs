@@ -9,7 +9,8 @@
 //! - `ctx` — the context (errors, warnings) and the checks tables share
 //!   (finite, SPD, gain matrices, multiples of `dt`); `rotation` — rotation specs;
 //! - `simulation` — `name`, `[simulation]`, `[output]`;
-//! - `scheme` — `[scheme]`; `leader` — `[leader]`; `agents` — `[[agent]]`;
+//! - `scheme` — `[scheme]` (with `scheme.law`, the printed law's warning);
+//!   `leader` — `[leader]`; `agents` — `[[agent]]`;
 //! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check);
 //! - `checks` — reachability from the leader, spectrum (sparse: extremes
 //!   and count; every eigenvalue only for small N), Appendix D;
@@ -97,6 +98,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     simulation::name(&mut c, s.name.as_ref());
     let time = simulation::simulation(&mut c, &s.simulation, &s.output);
     let scheme = scheme::scheme(&mut c, &s.scheme);
+    let law = scheme::law(&mut c, &s.scheme);
     let leader = leader::leader(&mut c, &s.leader, kind);
     let ids = agents::ids(&mut c, &s.agents);
     let bodies = agents::bodies(&mut c, &s.agents, kind);
@@ -120,6 +122,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         bodies,
         impaired,
         guard: envelope,
+        law,
     };
     let network = assemble::network(parts, &edges, &links);
     // The extremes of Ξ + LLᵀ are all the estimate needs (none without agents).
@@ -144,6 +147,15 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         stiffness: estimate,
         plugins: Vec::new(),
     })
+}
+
+impl Resolved {
+    /// The warning that `scheme.law = "as-printed"` runs a law known to be
+    /// wrong (a negative control), if it does.
+    #[must_use]
+    pub fn law_warning(&self) -> Option<&Issue> {
+        self.warnings.iter().find(|w| w.field == scheme::LAW_FIELD)
+    }
 }
 
 /// The name of a scheme as written in scenario files.

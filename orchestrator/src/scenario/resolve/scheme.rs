@@ -1,9 +1,10 @@
-//! `[scheme]`: which of the paper's schemes, with its scalar gains.
+//! `[scheme]`: which of the paper's schemes, with its scalar gains and the
+//! signs of its law (`scheme.law`).
 
 use super::ctx::Ctx;
 use super::kind_name;
 use crate::scenario::schema::{ObserverGainsSpec, SchemeKind, SchemeSpec};
-use attitude::control::ControlGains;
+use attitude::control::{ControlGains, ControlLaw};
 use attitude::network::Scheme;
 use attitude::observer::ObserverGains;
 
@@ -69,4 +70,30 @@ fn observer(c: &mut Ctx, o: &ObserverGainsSpec, kind: SchemeKind) -> ObserverGai
         k_w: c.positive("scheme.observer.k_omega", o.k_omega),
         k_sigma,
     }
+}
+
+/// The field that selects the law.
+pub(super) const LAW_FIELD: &str = "scheme.law";
+
+/// What `attsync run`, `sweep` and `check` say of `law = "as-printed"`.
+pub(super) const AS_PRINTED_WARNING: &str = "\"as-printed\" runs the paper's printed Σᵢ, Γᵢ \
+(eqs. sigmai, gammai), which are known wrong (erratum 1, docs/paper.md): scheme 1 stalls \
+near 1e-2 instead of converging (in scheme 2 the error fades with the observer's ω̂); \
+it is meant only as a negative control";
+
+/// `scheme.law`: the printed signs (erratum 1) only where the paper prints
+/// `Σᵢ`, `Γᵢ` (schemes 1 and 2, whose `controlconstantestimate` takes `Γᵢ`
+/// from eq. `gammai`), with a warning; scheme 3's `districontrol` has
+/// neither, so `as-printed` is refused there.
+pub(super) fn law(c: &mut Ctx, s: &SchemeSpec) -> ControlLaw {
+    match (s.law, s.kind) {
+        (ControlLaw::Corrected, _) => {}
+        (ControlLaw::AsPrinted, SchemeKind::Observerless) => c.err(
+            LAW_FIELD,
+            "\"as-printed\" is for the observer schemes only: the observerless law \
+             (districontrol) has no Σᵢ, Γᵢ, so the paper prints no other law to run",
+        ),
+        (ControlLaw::AsPrinted, _) => c.warn(LAW_FIELD, AS_PRINTED_WARNING),
+    }
+    s.law
 }

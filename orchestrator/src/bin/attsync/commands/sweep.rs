@@ -74,6 +74,9 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
     };
     o.validate()?;
     let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
+    if let Some(w) = base.resolved.law_warning() {
+        eprintln!("warning: {}: {w}", base.file.display());
+    }
     let nodes = base.resolved.network.agents.len() + 1;
     let cores = sweep::cores();
     match (o.run.engine, a.jobs) {
