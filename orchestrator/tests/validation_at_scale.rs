@@ -278,14 +278,14 @@ fn the_fast_path_and_the_collecting_pass_agree_on_valid_files() {
 #[test]
 fn a_failing_file_gets_the_same_problems_from_both() {
     let text = generated(500, 2, SchemeKind::ObserverConstant);
-    let (text, _) = insert_after(&text, "[[agent]]\n", 300, "inertia = 3\n");
+    let (text, _) = insert_after(&text, "[[agent]]\n", 300, "command = 3\n");
     let doc: Table = text.parse().expect("TOML");
     let (fast, slow) = (deserialize(&doc), collect(&doc));
     let (fast, slow) = (fast.expect_err("invalid"), slow.expect_err("invalid"));
     assert_eq!(format!("{fast:?}"), format!("{slow:?}"));
     assert!(
         fast.iter()
-            .any(|p| p.path.to_string() == "agent[300].inertia" && p.kind == Kind::Value),
+            .any(|p| p.path.to_string() == "agent[300].command" && p.kind == Kind::Value),
         "{fast:?}"
     );
 }
