@@ -12,8 +12,7 @@ use crate::scenario::schema::{
     SchemeSpec, Simulation,
 };
 use attitude::spectrum::{
-    appendix_d_balanced_gain, appendix_d_k_sigma_threshold,
-    appendix_d_min_eigenvalue_from_extremes,
+    appendix_d_balanced_gain, appendix_d_k_sigma_threshold, appendix_d_min_eigenvalue_from_extremes,
 };
 use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};

@@ -53,7 +53,10 @@ impl<'de> de::Deserializer<'de> for ValueRef<'de> {
                 let out = visitor.visit_seq(&mut seq)?;
                 match seq.0.len() {
                     0 => Ok(out),
-                    _ => Err(de::Error::invalid_length(a.len(), &"fewer elements in array")),
+                    _ => Err(de::Error::invalid_length(
+                        a.len(),
+                        &"fewer elements in array",
+                    )),
                 }
             }
             Value::Table(t) => visit_table(t, visitor),
@@ -138,7 +141,10 @@ struct Map<'a> {
 impl<'de> MapAccess<'de> for Map<'de> {
     type Error = Error;
 
-    fn next_key_seed<K: DeserializeSeed<'de>>(&mut self, seed: K) -> Result<Option<K::Value>, Error> {
+    fn next_key_seed<K: DeserializeSeed<'de>>(
+        &mut self,
+        seed: K,
+    ) -> Result<Option<K::Value>, Error> {
         let Some((k, v)) = self.iter.next() else {
             return Ok(None);
         };

@@ -210,10 +210,19 @@ mod tests {
         let mut t: Table = text.parse().unwrap();
         let before = t.clone();
         for (spec, error) in [
-            ("new.deeper[0].x=1", OverrideError::NotAnArray("deeper".into())),
-            ("new.deeper.list[0]=1", OverrideError::NoArray("list".into())),
+            (
+                "new.deeper[0].x=1",
+                OverrideError::NotAnArray("deeper".into()),
+            ),
+            (
+                "new.deeper.list[0]=1",
+                OverrideError::NoArray("list".into()),
+            ),
             ("simulation.dt.x=1", OverrideError::NotATable("dt".into())),
-            ("simulation[0].dt=1", OverrideError::NotAnArray("simulation".into())),
+            (
+                "simulation[0].dt=1",
+                OverrideError::NotAnArray("simulation".into()),
+            ),
             ("agent[0].id.x=2", OverrideError::NotATable("id".into())),
             (
                 "agent[3].id=2",

@@ -43,7 +43,10 @@ impl Ctx {
         if x.is_finite() {
             true
         } else {
-            self.err(field.to_string(), format!("must be a finite number, got {x}"));
+            self.err(
+                field.to_string(),
+                format!("must be a finite number, got {x}"),
+            );
             false
         }
     }
@@ -57,7 +60,10 @@ impl Ctx {
 
     pub(super) fn vec3(&mut self, field: impl Display, v: &[f64; 3]) -> Vector3<f64> {
         if v.iter().any(|x| !x.is_finite()) {
-            self.err(field.to_string(), format!("must hold finite numbers, got {v:?}"));
+            self.err(
+                field.to_string(),
+                format!("must hold finite numbers, got {v:?}"),
+            );
         }
         Vector3::from(*v)
     }
@@ -93,7 +99,11 @@ impl Ctx {
     }
 
     /// SPD with three distinct eigenvalues (every gain matrix A of the paper).
-    pub(super) fn gain(&mut self, field: impl Display + Copy, m: &MatrixSpec) -> Option<Matrix3<f64>> {
+    pub(super) fn gain(
+        &mut self,
+        field: impl Display + Copy,
+        m: &MatrixSpec,
+    ) -> Option<Matrix3<f64>> {
         let m = self.spd(field, m, "a gain matrix A")?;
         if !has_distinct_eigenvalues(&m) {
             self.err(
