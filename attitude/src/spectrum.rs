@@ -147,8 +147,7 @@ pub fn appendix_d_min_eigenvalue_from_extremes(
     k_sigma: f64,
     p: &Matrix3<f64>,
 ) -> f64 {
-    let q = (p + p.transpose()) * 0.5;
-    let theta = q.symmetric_eigenvalues().max();
+    let theta = worst_theta(p);
     let g_min = |mu: f64| {
         let (a, b) = (k_w * mu, k_sigma * mu - theta);
         let (mean, radius) = (0.5 * (a + b), (0.25 * (a - b) * (a - b) + 0.25).sqrt());
@@ -159,6 +158,80 @@ pub fn appendix_d_min_eigenvalue_from_extremes(
         }
     };
     g_min(lambda_min).min(g_min(lambda_max))
+}
+
+/// `λmax(Q)`, `Q = ½(P + Pᵀ)`: the `θ` at which `λmin G(μ, θ)` is smallest
+/// ([`appendix_d_min_eigenvalue_from_extremes`]).
+fn worst_theta(p: &Matrix3<f64>) -> f64 {
+    ((p + p.transpose()) * 0.5).symmetric_eigenvalues().max()
+}
+
+/// The boundary `k_σ*` of Appendix `appenD`'s `F ≻ 0` at `k_ω > 0`: `F ≻ 0`
+/// iff `k_σ > k_σ*` (the sign of [`appendix_d_min_eigenvalue_from_extremes`]).
+///
+/// # Equation
+/// ```text
+/// G(μ, θ) ≻ 0  ⇔  k_ω μ > 0  and  det G = k_ω μ (k_σ μ − θ) − ¼ > 0
+///             ⇔  k_σ > (θ + 1/(4 k_ω μ)) / μ
+/// k_σ* = max over μ ∈ {λmin, λmax} of that (0 if negative), θ = λmax(Q)
+/// ```
+/// The bound is convex in `μ > 0` (`a/μ² + θ/μ`, `a > 0`: a minimum and no
+/// interior maximum), so its maximum over `[λmin, λmax]` is at an end.
+/// Infinite when `λmin = 0` (a component without a leader link).
+///
+/// ```
+/// # use attitude::spectrum::*;
+/// # use nalgebra::Matrix3;
+/// let p = Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.3, -0.5, 0.0, 0.5, 0.0); // θ = 0.3
+/// let (ext, k_w) = ((0.05, 3.9), 14.0);
+/// let k = appendix_d_k_sigma_threshold(ext, k_w, &p);
+/// assert!(appendix_d_min_eigenvalue_from_extremes(ext, k_w, k * 1.001, &p) > 0.0);
+/// assert!(appendix_d_min_eigenvalue_from_extremes(ext, k_w, k * 0.999, &p) < 0.0);
+/// ```
+#[must_use]
+pub fn appendix_d_k_sigma_threshold(extremes: (f64, f64), k_w: f64, p: &Matrix3<f64>) -> f64 {
+    let theta = worst_theta(p);
+    [extremes.0, extremes.1]
+        .iter()
+        .map(|&mu| {
+            if mu > 0.0 {
+                (1.0 / (4.0 * k_w * mu) + theta) / mu
+            } else {
+                f64::INFINITY
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The smallest `k` with `k ≥ margin · k_σ*(k_ω = k)`
+/// ([`appendix_d_k_sigma_threshold`]): equal gains `k_σ = k_ω = k` that
+/// satisfy `F ≻ 0` with `k_σ` to spare by the factor `margin ≥ 1`.
+///
+/// # Equation
+/// ```text
+/// per μ, x = k μ:  x ≥ margin (θ + 1/(4x))  ⇔  x² − margin θ x − margin/4 ≥ 0
+///                  ⇔  k μ ≥ (margin θ + √(margin² θ² + margin)) / 2
+/// ```
+/// The largest over the two ends is at `λmin`. For `θ = 0` the condition is
+/// on the product, `k_σ k_ω λmin² ≥ margin/4`: `k = √margin / (2 λmin)`.
+/// Infinite when `λmin = 0`.
+///
+/// ```
+/// # use attitude::spectrum::*;
+/// # use nalgebra::Matrix3;
+/// let p = Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.3, -0.5, 0.0, 0.5, 0.0); // θ = 0.3
+/// let ext = (0.01, 3.9);
+/// let k = appendix_d_balanced_gain(ext, &p, 1.25);
+/// approx::assert_relative_eq!(k, 1.25 * appendix_d_k_sigma_threshold(ext, k, &p), max_relative = 1e-12);
+/// ```
+#[must_use]
+pub fn appendix_d_balanced_gain(extremes: (f64, f64), p: &Matrix3<f64>, margin: f64) -> f64 {
+    let theta = worst_theta(p);
+    let x = 0.5 * (margin * theta + (margin * margin * theta * theta + margin).sqrt());
+    [extremes.0, extremes.1]
+        .iter()
+        .map(|&mu| if mu > 0.0 { x / mu } else { f64::INFINITY })
+        .fold(0.0, f64::max)
 }
 
 /// Appendix `appenD`'s test `F ≻ 0` by a block Cholesky of `F` with one

@@ -5,15 +5,15 @@
 //! the duration (the slowest linear mode) so that it converges.
 
 use crate::options::StiffnessCheck;
-use crate::scenario::Resolved;
-use crate::scenario::resolve::stable_dt;
+use crate::scenario::resolve::{kind_name, stable_dt};
 use crate::scenario::schema::{
     AgentSpec, ControlGainsSpec, CouplingKind, EdgeSpec, LeaderLinkSpec, LeaderSpec, MatrixSpec,
     ObserverGainsSpec, ObserverInit, Output, ReferenceKind, RotationSpec, Scenario, SchemeKind,
     SchemeSpec, Simulation,
 };
-use attitude::checks::{appendix_d_min_eigenvalue_from_extremes, sym_eigenvalues};
-use nalgebra::Matrix3;
+use attitude::spectrum::{
+    appendix_d_balanced_gain, appendix_d_k_sigma_threshold, appendix_d_min_eigenvalue_from_extremes,
+};
 use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -32,6 +32,25 @@ pub struct TreeParams {
     /// Horizon, s (`None`: [`DEFAULT_DURATION`] or longer, as the slowest
     /// linear mode needs; see [`CONVERGE_MULTIPLE`]).
     pub duration: Option<f64>,
+}
+
+impl TreeParams {
+    /// The command that generates this tree, every parameter given (the
+    /// first line of the file `attsync gen tree` writes).
+    #[must_use]
+    pub fn command_line(&self) -> String {
+        let mut c = format!(
+            "attsync gen tree --agents {} --leader-links {} --seed {} --scheme {}",
+            self.agents,
+            self.leader_links,
+            self.seed,
+            kind_name(self.scheme)
+        );
+        if let Some(d) = self.duration {
+            c.push_str(&format!(" --duration {d}"));
+        }
+        c
+    }
 }
 
 /// `P` of the paper's experiment: a decaying mode and an oscillating pair `±i/√2`.
@@ -232,36 +251,36 @@ pub const DT_FRACTION: f64 = 0.5;
 const PAPER_DT: f64 = 0.001;
 
 /// For scheme 1, Theorem 1's gain condition (`F > 0`, Appendix D). The
-/// paper's gains when `k_σ = 12 ≥ K_SIGMA_MARGIN · k_σ*(k_ω = 14)`;
-/// otherwise `k_ω = k_σ = k`, the smallest equal pair with
-/// `k_σ ≥ K_SIGMA_MARGIN · k_σ*(k_ω = k)` (the condition is on the product,
-/// [`balanced_gain`]: equal gains keep the fastest mode, `∝ max(k_ω, k_σ)`,
-/// and so the step, as large as possible). Confirmed by the exact test.
-/// Returns the reason, for the file's header.
+/// paper's gains when `k_σ = 12 ≥ K_SIGMA_MARGIN · k_σ*(k_ω = 14)`
+/// ([`appendix_d_k_sigma_threshold`]); otherwise `k_ω = k_σ = k`, the
+/// smallest equal pair with `k_σ ≥ K_SIGMA_MARGIN · k_σ*(k_ω = k)` (the
+/// condition is on the product, [`appendix_d_balanced_gain`]: equal gains
+/// keep the fastest mode, `∝ max(k_ω, k_σ)`, and so the step, as large as
+/// possible). Confirmed by the exact test. Returns the reason, for the
+/// file's header.
 fn pick_gains(s: &mut Scenario) -> Option<String> {
     let r = crate::scenario::resolve::resolve_with(s, StiffnessCheck::Warn).ok()?;
     let o = s.scheme.observer.as_mut()?;
     let paper = o.k_sigma?;
     let p = r.network.p;
     // The thresholds are decreasing in λ > 0: λmin decides them.
-    let (lo, hi) = r.spectrum_extremes;
-    let nu = sym_eigenvalues(&(-(p + p.transpose()) * 0.5))[0];
-    let paper_ok = K_SIGMA_MARGIN * k_sigma_threshold(&[lo, hi], o.k_omega, nu) <= paper;
+    let ext = r.spectrum_extremes;
+    let paper_ok = K_SIGMA_MARGIN * appendix_d_k_sigma_threshold(ext, o.k_omega, &p) <= paper;
     let (mut k_w, mut k_s) = if paper_ok {
         (o.k_omega, paper)
     } else {
-        let k = balanced_gain(&[lo, hi], nu, K_SIGMA_MARGIN).max(o.k_omega.max(paper));
+        let k = appendix_d_balanced_gain(ext, &p, K_SIGMA_MARGIN).max(o.k_omega.max(paper));
         (k, k)
     };
     // The exact test, once: a round-off at the boundary only ever asks for more.
     for _ in 0..8 {
-        if f_is_positive_definite(&r, k_w, k_s, &p) {
+        if appendix_d_min_eigenvalue_from_extremes(ext, k_w, k_s, &p) > 0.0 {
             break;
         }
         (k_w, k_s) = (k_w * 2.0, k_s * 2.0);
     }
     (o.k_omega, o.k_sigma) = (k_w, Some(k_s));
-    let threshold = k_sigma_threshold(&[lo, hi], k_w, nu);
+    let threshold = appendix_d_k_sigma_threshold(ext, k_w, &p);
     Some(if paper_ok {
         format!(
             "k_sigma = {k_s}, k_omega = {k_w} (the paper's): F of Appendix D (Theorem 1's gain condition) is positive definite iff k_sigma > {threshold:.4e}, and {K_SIGMA_MARGIN} × that <= {paper}"
@@ -271,38 +290,6 @@ fn pick_gains(s: &mut Scenario) -> Option<String> {
             "k_sigma = k_omega = {k_s:.4}: F of Appendix D (Theorem 1's gain condition) is positive definite iff k_sigma > {threshold:.4e} at this k_omega; the condition is on the product k_sigma·k_omega, so both are raised together to the smallest equal pair with k_sigma >= {K_SIGMA_MARGIN} × that (the paper's {paper} is too small for this graph; docs/stiffness.md)"
         )
     })
-}
-
-/// The smallest `k` with `k ≥ margin · k_σ*(k_ω = k)`: per eigenvalue λ of
-/// `Ξ + LLᵀ`, `k λ + ν − margin/(4 k λ) ≥ 0` with `k_σ = k_ω = k`
-/// ([`k_sigma_threshold`] with `k_σ` divided by the margin), i.e.
-/// `k λ = (−ν + √(ν² + margin)) / 2`. For `ν = 0` the condition is
-/// `k_σ k_ω λmin² > 1/4`, a product: `k = √margin / (2 λmin)`.
-fn balanced_gain(spectrum: &[f64], nu: f64, margin: f64) -> f64 {
-    spectrum
-        .iter()
-        .filter(|&&l| l > 0.0)
-        .map(|&l| (-margin * nu + (margin * margin * nu * nu + margin).sqrt()) / (2.0 * l))
-        .fold(0.0, f64::max)
-}
-
-/// Whether `F > 0` (Appendix D) for `k_σ`: the one call of the exact test
-/// (dense today; a sparse test replaces this line).
-fn f_is_positive_definite(r: &Resolved, k_w: f64, k_sigma: f64, p: &Matrix3<f64>) -> bool {
-    appendix_d_min_eigenvalue_from_extremes(r.spectrum_extremes, k_w, k_sigma, p) > 0.0
-}
-
-/// The boundary `k_σ*` of `F > 0`. With `F₁ = (Ξ + LLᵀ) ⊗ I₃ > 0`, `F > 0`
-/// iff its Schur complement `k_σ F₁ − ½(I ⊗ (P + Pᵀ)) − F₁⁻¹ / (4 k_ω)` is;
-/// its blocks commute, so per eigenvalue λ of `Ξ + LLᵀ` and ν of
-/// `−½(P + Pᵀ)` the condition is `k_σ λ + ν − 1/(4 k_ω λ) > 0`:
-/// `k_σ* = max_λ (1/(4 k_ω λ) − ν_min) / λ` (0 if negative), `nu` = `ν_min`.
-fn k_sigma_threshold(spectrum: &[f64], k_w: f64, nu: f64) -> f64 {
-    spectrum
-        .iter()
-        .filter(|&&l| l > 0.0)
-        .map(|&l| (1.0 / (4.0 * k_w * l) - nu) / l)
-        .fold(0.0, f64::max)
 }
 
 /// `dt ≤ DT_FRACTION · dt_max` as `0.001 / n` (so that the default sample

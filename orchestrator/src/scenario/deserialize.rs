@@ -1,6 +1,8 @@
 //! The effective document → [`Scenario`], collecting every schema problem
 //! (unknown key, wrong type, missing field) instead of stopping at the first.
 //!
+//! A valid document is read once, in place (`borrowed`: no copy of the
+//! table). Only when that fails does the collecting pass ([`collect`]) run.
 //! serde stops at the first error; so after each one the offending value is
 //! removed from a copy of the document and the copy deserialised again, until
 //! it fits (or [`MAX_PROBLEMS`] are found). A missing field that is missing
@@ -8,7 +10,9 @@
 //! the coordinates of the document as written (array indices count removed
 //! elements).
 
+use super::borrowed::TableRef;
 use super::schema::Scenario;
+use serde::Deserialize;
 use serde_path_to_error::Segment;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt;
@@ -96,8 +100,20 @@ impl Removed {
     }
 }
 
-/// `doc` as a [`Scenario`], or every problem found (at most [`MAX_PROBLEMS`]).
+/// `doc` as a [`Scenario`], or every problem found (at most [`MAX_PROBLEMS`]):
+/// read in place first, and only if that fails by [`collect`].
 pub fn deserialize(doc: &Table) -> Result<Scenario, Vec<Problem>> {
+    match Scenario::deserialize(TableRef(doc)) {
+        Ok(s) => Ok(s),
+        Err(_) => collect(doc),
+    }
+}
+
+/// `doc` as a [`Scenario`], or every problem found (at most
+/// [`MAX_PROBLEMS`]), by the collecting pass alone (toml's own
+/// deserializer, on a copy). [`deserialize`] gives the same result, faster
+/// on a valid document.
+pub fn collect(doc: &Table) -> Result<Scenario, Vec<Problem>> {
     let mut copy = doc.clone();
     let mut removed = Removed::default();
     let mut problems = Vec::new();

@@ -14,11 +14,13 @@
 //! - [`overrides`] — `--set key.path=value`;
 //! - `parse` — text + overrides → document and [`Scenario`], every problem at once;
 //! - [`deserialize`] — the document → [`Scenario`], every schema problem;
+//!   `borrowed` — its fast path: the document read in place, without a copy;
 //! - [`resolve`] — validation and resolution into the network, one phase per table;
 //! - [`plugin`] — plug-in agents (`[[agent]] command`);
 //! - [`report`] — the text `attsync check` prints;
 //! - `error` — [`ScenarioError`].
 
+mod borrowed;
 pub mod deserialize;
 mod error;
 pub mod input;
@@ -123,6 +125,7 @@ pub fn load_str_with(
         _ => PathBuf::from("."),
     };
     let dir = std::path::absolute(&dir).unwrap_or(dir);
+    let start = std::time::Instant::now();
     let resolved = match (
         resolve::resolve_with(&scenario, check),
         plugin::resolve(&scenario, &dir),
@@ -138,6 +141,7 @@ pub fn load_str_with(
         file: file.to_owned(),
         issues,
     })?;
+    tracing::debug!(elapsed = ?start.elapsed(), "scenario: resolved");
     Ok(Loaded {
         file: file.to_owned(),
         document,

@@ -48,11 +48,53 @@ pub fn path_of(spec: &str) -> Option<&str> {
     spec.split_once('=').map(|(path, _)| path.trim())
 }
 
-/// Applies one `key.path=value` override to `doc`.
+/// Applies one `key.path=value` override to `doc`; on an error `doc` is
+/// left as it was (the path is walked read-only first, so that a large
+/// document need not be copied to keep a half-applied override out).
 pub fn apply(doc: &mut Table, spec: &str) -> Result<(), OverrideError> {
     let (path, raw) = spec.split_once('=').ok_or(OverrideError::NoEquals)?;
     let value = parse_value(raw.trim());
     let segments = parse_path(path.trim())?;
+    check(doc, &segments)?;
+    set(doc, &segments, value)
+}
+
+/// A path of `(key, index)` segments.
+type Segments = [(String, Option<usize>)];
+
+/// The errors [`set`] would meet on `doc`, without changing it: a missing
+/// key on the way is a table `set` creates (empty: indexing it fails).
+fn check(doc: &Table, segments: &Segments) -> Result<(), OverrideError> {
+    let (last, parents) = segments
+        .split_last()
+        .expect("parse_path returns ≥ 1 segment");
+    let mut table = Some(doc);
+    for (key, index) in parents {
+        let entry = match (table.and_then(|t| t.get(key)), index) {
+            (None, Some(_)) => return Err(OverrideError::NotAnArray(key.clone())),
+            (None, None) => None,
+            (Some(v), Some(k)) => Some(index_ref(v, key, *k)?),
+            (Some(v), None) => Some(v),
+        };
+        table = entry
+            .map(|v| {
+                v.as_table()
+                    .ok_or_else(|| OverrideError::NotATable(key.clone()))
+            })
+            .transpose()?;
+    }
+    let (key, index) = last;
+    if let Some(k) = index {
+        let entry = table
+            .and_then(|t| t.get(key))
+            .ok_or_else(|| OverrideError::NoArray(key.clone()))?;
+        index_ref(entry, key, *k)?;
+    }
+    Ok(())
+}
+
+/// Sets the value at `segments` in `doc`, creating missing tables.
+fn set(doc: &mut Table, segments: &Segments, value: Value) -> Result<(), OverrideError> {
     let (last, parents) = segments
         .split_last()
         .expect("parse_path returns ≥ 1 segment");
@@ -82,6 +124,17 @@ pub fn apply(doc: &mut Table, spec: &str) -> Result<(), OverrideError> {
         }
     }
     Ok(())
+}
+
+fn index_ref<'a>(v: &'a Value, key: &str, k: usize) -> Result<&'a Value, OverrideError> {
+    let arr = v
+        .as_array()
+        .ok_or_else(|| OverrideError::NotAnArray(key.to_owned()))?;
+    arr.get(k).ok_or_else(|| OverrideError::OutOfRange {
+        key: key.to_owned(),
+        index: k,
+        len: arr.len(),
+    })
 }
 
 fn index_into<'a>(v: &'a mut Value, key: &str, k: usize) -> Result<&'a mut Value, OverrideError> {
@@ -149,5 +202,41 @@ mod tests {
                 .contains("out of range")
         );
         assert!(apply(&mut t, "no_equals").is_err());
+    }
+
+    #[test]
+    fn a_failed_override_leaves_the_document_as_it_was() {
+        let text = "[simulation]\ndt = 0.001\n[[agent]]\nid = 1\n";
+        let mut t: Table = text.parse().unwrap();
+        let before = t.clone();
+        for (spec, error) in [
+            (
+                "new.deeper[0].x=1",
+                OverrideError::NotAnArray("deeper".into()),
+            ),
+            (
+                "new.deeper.list[0]=1",
+                OverrideError::NoArray("list".into()),
+            ),
+            ("simulation.dt.x=1", OverrideError::NotATable("dt".into())),
+            (
+                "simulation[0].dt=1",
+                OverrideError::NotAnArray("simulation".into()),
+            ),
+            ("agent[0].id.x=2", OverrideError::NotATable("id".into())),
+            (
+                "agent[3].id=2",
+                OverrideError::OutOfRange {
+                    key: "agent".into(),
+                    index: 3,
+                    len: 1,
+                },
+            ),
+        ] {
+            assert_eq!(apply(&mut t, spec), Err(error), "{spec}");
+            assert_eq!(t, before, "{spec} left a change behind");
+        }
+        apply(&mut t, "new.deeper.x=1").unwrap();
+        assert_eq!(t["new"]["deeper"]["x"].as_integer(), Some(1));
     }
 }

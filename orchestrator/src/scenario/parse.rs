@@ -6,8 +6,10 @@ use super::input::{MAX_QUOTE_CHARS, clip, locate};
 use super::overrides;
 use super::resolve::Issue;
 use super::schema::Scenario;
+use std::time::Instant;
 use toml::Table;
 use toml::de::{DeArray, DeTable};
+use tracing::debug;
 
 /// Most characters of a reason (serde's messages list the expected keys).
 const MAX_REASON_CHARS: usize = 600;
@@ -28,26 +30,27 @@ pub(super) enum Failure {
 
 /// The effective document and its typed form.
 pub(super) fn parse(text: &str, sets: &[String]) -> Result<(Table, Scenario), Failure> {
+    let start = Instant::now();
     let mut document: Table = text
         .parse()
         .map_err(|e: toml::de::Error| Failure::Syntax(syntax(text, &e)))?;
+    debug!(bytes = text.len(), elapsed = ?start.elapsed(), "scenario: TOML parsed");
     let mut bad = Vec::new();
     let mut applied = Vec::new();
     for o in sets {
-        // On a copy, so that a half-applied override leaves nothing behind.
-        let mut next = document.clone();
-        match overrides::apply(&mut next, o) {
-            Ok(()) => {
-                document = next;
-                applied.extend(overrides::path_of(o));
-            }
+        // A failed override leaves the document as it was.
+        match overrides::apply(&mut document, o) {
+            Ok(()) => applied.extend(overrides::path_of(o)),
             Err(e) => bad.push(Issue {
                 field: format!("--set {}", clip(o, MAX_QUOTE_CHARS)),
                 reason: e.to_string(),
             }),
         }
     }
-    match deserialize::deserialize(&document) {
+    let start = Instant::now();
+    let typed = deserialize::deserialize(&document);
+    debug!(elapsed = ?start.elapsed(), ok = typed.is_ok(), "scenario: schema read");
+    match typed {
         Ok(s) if bad.is_empty() => Ok((document, s)),
         Ok(_) => Err(Failure::Schema {
             overrides: bad,

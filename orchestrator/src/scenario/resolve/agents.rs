@@ -7,6 +7,7 @@ use attitude::body::Inertia;
 use attitude::network::AgentState;
 use nalgebra::{Matrix3, Vector3};
 use std::collections::BTreeMap;
+use std::fmt::Display;
 
 /// An agent's body, `Āᵢ` and initial state.
 pub(super) type Body = (Inertia, Matrix3<f64>, AgentState);
@@ -38,7 +39,7 @@ pub(super) fn ids(c: &mut Ctx, agents: &[AgentSpec]) -> BTreeMap<u32, usize> {
 pub(super) fn bodies(c: &mut Ctx, agents: &[AgentSpec], kind: SchemeKind) -> BTreeMap<u32, Body> {
     let mut bodies = BTreeMap::new();
     for (k, a) in agents.iter().enumerate() {
-        if let Some(b) = body(c, &format!("agent[{k}]"), a, kind) {
+        if let Some(b) = body(c, format_args!("agent[{k}]"), a, kind) {
             bodies.insert(a.id, b);
         }
     }
@@ -46,10 +47,10 @@ pub(super) fn bodies(c: &mut Ctx, agents: &[AgentSpec], kind: SchemeKind) -> BTr
 }
 
 /// Agent `a` (at field `f`), or `None` if any of its fields is invalid.
-fn body(c: &mut Ctx, f: &str, a: &AgentSpec, kind: SchemeKind) -> Option<Body> {
-    let j = c.spd(&format!("{f}.inertia"), &a.inertia, "the inertia J");
-    let r = c.rotation(&format!("{f}.attitude"), &a.attitude);
-    let w = c.vec3(&format!("{f}.omega"), &a.omega);
+fn body(c: &mut Ctx, f: impl Display + Copy, a: &AgentSpec, kind: SchemeKind) -> Option<Body> {
+    let j = c.spd(format_args!("{f}.inertia"), &a.inertia, "the inertia J");
+    let r = c.rotation(format_args!("{f}.attitude"), &a.attitude);
+    let w = c.vec3(format_args!("{f}.omega"), &a.omega);
     let (a_bar, obs) = if kind == SchemeKind::Observerless {
         for (set, name) in [
             (a.control_gain.is_some(), "control_gain"),
@@ -65,7 +66,7 @@ fn body(c: &mut Ctx, f: &str, a: &AgentSpec, kind: SchemeKind) -> Option<Body> {
         )
     } else {
         let a_bar = match &a.control_gain {
-            Some(m) => c.gain(&format!("{f}.control_gain"), m),
+            Some(m) => c.gain(format_args!("{f}.control_gain"), m),
             None => {
                 c.err(
                     format!("{f}.control_gain"),
@@ -90,7 +91,7 @@ fn body(c: &mut Ctx, f: &str, a: &AgentSpec, kind: SchemeKind) -> Option<Body> {
 /// The observer's initial state of agent `f` under a scheme with an observer.
 fn observer(
     c: &mut Ctx,
-    f: &str,
+    f: impl Display + Copy,
     o: Option<&ObserverInit>,
     kind: SchemeKind,
 ) -> Option<ObserverState> {
@@ -104,10 +105,12 @@ fn observer(
         );
         return None;
     };
-    let rh = c.rotation(&format!("{f}.observer.attitude"), &o.attitude);
-    let wh = c.vec3(&format!("{f}.observer.omega"), &o.omega);
+    let rh = c.rotation(format_args!("{f}.observer.attitude"), &o.attitude);
+    let wh = c.vec3(format_args!("{f}.observer.omega"), &o.omega);
     let sh = match (&o.sigma, kind) {
-        (Some(sg), SchemeKind::ObserverTimeVarying) => c.vec3(&format!("{f}.observer.sigma"), sg),
+        (Some(sg), SchemeKind::ObserverTimeVarying) => {
+            c.vec3(format_args!("{f}.observer.sigma"), sg)
+        }
         (None, SchemeKind::ObserverTimeVarying) => {
             c.err(
                 format!("{f}.observer.sigma"),

@@ -5,6 +5,7 @@ use super::ctx::Ctx;
 use crate::scenario::schema::{EdgeSpec, LeaderLinkSpec};
 use nalgebra::Matrix3;
 use std::collections::BTreeMap;
+use std::fmt;
 
 /// The follower edges that name two known, distinct agents.
 #[derive(Default)]
@@ -30,10 +31,10 @@ pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &BTreeMap<u32, usize>)
     let mut first_edge: BTreeMap<(u32, u32), usize> = BTreeMap::new();
     let mut dsu = Dsu::default();
     for (k, e) in specs.iter().enumerate() {
-        let f = format!("edge[{k}]");
+        let f = Edge(k);
         let [a, b] = e.agents;
         let key = (a.min(b), a.max(b));
-        let ok = endpoints_ok(c, &f, e.agents, ids) && {
+        let ok = endpoints_ok(c, f, e.agents, ids) && {
             let first = first_edge.get(&key);
             if let Some(first) = first {
                 c.err(
@@ -43,7 +44,7 @@ pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &BTreeMap<u32, usize>)
             }
             first.is_none()
         };
-        let g = c.gain(&format!("{f}.gain"), &e.gain);
+        let g = c.gain(format_args!("{f}.gain"), &e.gain);
         if ok {
             first_edge.insert(key, k);
             if !dsu.union(key.0, key.1) {
@@ -62,7 +63,7 @@ pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &BTreeMap<u32, usize>)
 }
 
 /// Both ends of edge `f` are known agents, and distinct.
-fn endpoints_ok(c: &mut Ctx, f: &str, [a, b]: [u32; 2], ids: &BTreeMap<u32, usize>) -> bool {
+fn endpoints_ok(c: &mut Ctx, f: Edge, [a, b]: [u32; 2], ids: &BTreeMap<u32, usize>) -> bool {
     let mut ok = true;
     for x in [a, b] {
         if !ids.contains_key(&x) {
@@ -95,18 +96,17 @@ pub(super) fn leader_links(
 ) -> LeaderLinks {
     let mut out = LeaderLinks::default();
     for (k, l) in specs.iter().enumerate() {
-        let f = format!("leader_link[{k}]");
-        let g = c.gain(&format!("{f}.gain"), &l.gain);
+        let g = c.gain(format_args!("leader_link[{k}].gain"), &l.gain);
         if !ids.contains_key(&l.agent) {
             c.err(
-                format!("{f}.agent"),
+                format!("leader_link[{k}].agent"),
                 format!("unknown agent id {}", l.agent),
             );
             continue;
         }
         if let Some(first) = out.seen.insert(l.agent, k) {
             c.err(
-                format!("{f}.agent"),
+                format!("leader_link[{k}].agent"),
                 format!(
                     "duplicate leader link to agent {} (also leader_link[{first}])",
                     l.agent
@@ -125,6 +125,16 @@ pub(super) fn leader_links(
         );
     }
     out
+}
+
+/// `edge[k]`, written out only for a problem.
+#[derive(Clone, Copy)]
+struct Edge(usize);
+
+impl fmt::Display for Edge {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "edge[{}]", self.0)
+    }
 }
 
 /// Union–find over agent ids, for the forest check.

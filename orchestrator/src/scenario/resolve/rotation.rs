@@ -4,11 +4,16 @@ use super::ctx::{Ctx, rows};
 use crate::scenario::schema::RotationSpec;
 use attitude::so3::{orthogonality_defect, rot};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
+use std::fmt::Display;
 
 impl Ctx {
     /// The rotation `r` describes, or `None` (with an error) if it is not
     /// exactly one well-formed form.
-    pub(super) fn rotation(&mut self, field: &str, r: &RotationSpec) -> Option<Matrix3<f64>> {
+    pub(super) fn rotation(
+        &mut self,
+        field: impl Display + Copy,
+        r: &RotationSpec,
+    ) -> Option<Matrix3<f64>> {
         let angles = [
             r.angle_rad.map(|a| ("angle_rad", a)),
             r.angle_deg.map(|a| ("angle_deg", a.to_radians())),
@@ -20,7 +25,7 @@ impl Ctx {
             + usize::from(r.matrix.is_some());
         if forms != 1 {
             self.err(
-                field,
+                field.to_string(),
                 "give exactly one of: axis with one of angle_rad/angle_deg/angle_pi; quaternion = [w, x, y, z]; matrix = [[..], [..], [..]]",
             );
             return None;
@@ -65,11 +70,14 @@ impl Ctx {
             return None;
         };
         if angles.len() != 1 {
-            self.err(field, "give exactly one of angle_rad, angle_deg, angle_pi");
+            self.err(
+                field.to_string(),
+                "give exactly one of angle_rad, angle_deg, angle_pi",
+            );
             return None;
         }
         let (name, angle) = angles[0];
-        if !self.finite(&format!("{field}.{name}"), angle) {
+        if !self.finite(format_args!("{field}.{name}"), angle) {
             return None;
         }
         let u = Vector3::from(axis);
