@@ -133,8 +133,10 @@ pub struct Agent {
     dt: f64,
     held_nbrs: Vec<Exchanged>,
     held_leader: Option<Exchanged>,
-    /// Impaired links, per input (neighbours, then the leader).
-    links: Vec<Option<Link>>,
+    /// Impaired links, per input (neighbours, then the leader), boxed so
+    /// that an agent without any (the common case) steps over a few
+    /// pointers, not over whole links, at every stage.
+    links: Vec<Option<Box<Link>>>,
     /// Values refused as untrusted, per input (neighbours, then the leader).
     rejected: Vec<u64>,
     /// Current step index.
@@ -149,8 +151,11 @@ impl Agent {
         let gains = model.neighbours.iter().map(|n| n.a).collect();
         let held_nbrs = vec![Exchanged::identity(); model.neighbours.len()];
         let held_leader = model.leader_gain.map(|_| Exchanged::identity());
-        let impaired = |l: &Option<LinkModel>| l.filter(LinkModel::is_impaired).map(Link::new);
-        let mut links: Vec<Option<Link>> =
+        let impaired = |l: &Option<LinkModel>| {
+            l.filter(LinkModel::is_impaired)
+                .map(|m| Box::new(Link::new(m)))
+        };
+        let mut links: Vec<Option<Box<Link>>> =
             model.neighbours.iter().map(|n| impaired(&n.link)).collect();
         if model.leader_gain.is_some() {
             links.push(impaired(&model.leader_link));
@@ -254,7 +259,7 @@ impl Agent {
         ids.zip(self.links.iter().zip(&self.rejected))
             .filter(|(_, (l, r))| l.is_some() || **r > 0)
             .map(|(id, (l, &rejected))| {
-                let base = l.as_ref().map(Link::stats).unwrap_or_default();
+                let base = l.as_deref().map(Link::stats).unwrap_or_default();
                 (id, LinkStats { rejected, ..base })
             })
             .collect()

@@ -9,6 +9,7 @@
 //! values it holds, so the results are bit-identical for any thread count.
 //!
 //! # Layout
+//! - `pass`: one stage over a run of agents (receive, advance, publish, check).
 //! - `crew`: the parallel step (shares of agents, the exchange barrier).
 //! - `board`: the values threads leave for each other (atomic words, bit-exact).
 //! - `barrier`: a barrier that spins briefly, then blocks.
@@ -16,14 +17,16 @@
 mod barrier;
 mod board;
 mod crew;
+mod pass;
 
 use crate::agent::Agent;
-use crate::guard::{self, Divergence};
+use crate::guard::{self, Divergence, Violation};
 use crate::network::{AgentState, Network};
 use crate::reference::{Leader, LeaderState};
-use crate::schedule::Schedule;
+use crate::schedule::{Schedule, Slot};
 use board::Judged;
 use crew::{Board, Plan, Share};
+use pass::{Stage, pass};
 
 /// Fewest agents per thread [`InProcess::with_threads`] gives a thread:
 /// below it the barriers cost more than the thread saves (measured in
@@ -57,8 +60,13 @@ pub struct InProcess {
     /// Threads [`Self::run`] uses (1: the calling thread only).
     threads: usize,
     /// The one-thread step's published values and their verdicts
-    /// ([`crate::network::Exchanged::trust`], judged once per sender).
-    published: Vec<Judged>,
+    /// ([`crate::network::Exchanged::trust`], judged once per sender): the
+    /// next exchange reads `published[0]`; a pass at an exchange writes the
+    /// values of the exchange after it into `published[1]`, then the two
+    /// swap.
+    published: [Vec<Judged>; 2],
+    /// The exchange (step, stage) whose values the last pass published.
+    ready: Option<(u64, u32)>,
 }
 
 impl InProcess {
@@ -71,6 +79,7 @@ impl InProcess {
             .iter()
             .map(|a| Agent::new(a.model.clone(), a.initial, net.dt))
             .collect();
+        let n = agents.len();
         let nbr_index = net.neighbour_indices();
         let states = agents.iter().map(|a| *a.state()).collect();
         Self {
@@ -82,7 +91,8 @@ impl InProcess {
             states,
             sampled: (0, Vec::new()),
             threads: 1,
-            published: Vec::new(),
+            published: [vec![Judged::default(); n], vec![Judged::default(); n]],
+            ready: None,
         }
     }
 
@@ -133,26 +143,66 @@ impl InProcess {
     /// Advances every node by one step (four stages, exchanging as the
     /// coupling says), on the calling thread.
     pub fn step(&mut self) {
-        let published = &mut self.published;
-        for slot in Schedule::new(self.net.coupling, self.net.steps).stages(self.step) {
-            if slot.exchange {
-                let from_leader = Judged::of(self.leader.stage_exchange());
-                published.clear();
-                published.extend(self.agents.iter().map(|a| Judged::of(a.stage_exchange())));
-                for (agent, nbrs) in self.agents.iter_mut().zip(&self.nbr_index) {
-                    for (k, &j) in nbrs.iter().enumerate() {
-                        let Judged(x, trusted) = published[j];
-                        agent.receive_neighbour_judged(k, x, trusted);
-                    }
-                    agent.receive_leader_judged(from_leader.0, from_leader.1);
-                }
-            }
+        self.advance_step();
+        self.refresh_states();
+    }
+
+    /// One step on the calling thread, one [`pass`] over the agents per
+    /// stage; returns the first agent whose new state is outside the
+    /// envelope (index, violation). Leaves `states` as it was.
+    fn advance_step(&mut self) -> Option<(usize, Violation)> {
+        let schedule = Schedule::new(self.net.coupling, self.net.steps);
+        let mut found = None;
+        for slot in schedule.stages(self.step) {
+            let leader = slot.exchange.then(|| {
+                self.publish_if_needed(slot);
+                Judged::of(self.leader.stage_exchange())
+            });
             self.leader.advance();
-            for agent in &mut self.agents {
-                agent.advance();
+            let next = schedule.next(slot).filter(|x| x.exchange);
+            let stage = Stage {
+                leader,
+                publish: next.is_some(),
+                check: slot.ends_step().then_some(&self.net.guard),
+            };
+            // Read this exchange's buffer; write the next exchange's (the
+            // other one at an exchange; nothing is read otherwise).
+            let [now, after] = &mut self.published;
+            let (read, out) = if slot.exchange {
+                (&*now, after)
+            } else {
+                (&*after, now)
+            };
+            found = pass(
+                &mut self.agents,
+                &self.nbr_index,
+                stage,
+                |j| read[j],
+                |k, x| out[k] = x,
+            );
+            if slot.exchange {
+                self.published.swap(0, 1);
+            }
+            if let Some(x) = next {
+                self.ready = Some((x.step, x.stage));
             }
         }
         self.step += 1;
+        found
+    }
+
+    /// Publishes every agent's stage state into `published[0]` for the
+    /// exchange `slot`, unless the last pass did.
+    fn publish_if_needed(&mut self, slot: Slot) {
+        if self.ready != Some((slot.step, slot.stage)) {
+            for (p, a) in self.published[0].iter_mut().zip(&self.agents) {
+                *p = Judged::of(a.stage_exchange());
+            }
+        }
+    }
+
+    /// Every agent's state at the start of its current step into `states`.
+    fn refresh_states(&mut self) {
         for (s, a) in self.states.iter_mut().zip(&self.agents) {
             *s = *a.state();
         }
@@ -195,15 +245,22 @@ impl InProcess {
             }
         }
         if self.threads > 1 && self.step < self.net.steps {
-            return self.run_parallel(on_sample);
+            self.ready = None;
+            let diverged = self.run_parallel(on_sample);
+            self.refresh_states();
+            return diverged;
         }
         while self.step < self.net.steps {
-            self.step();
-            if let Some(d) = self.divergence() {
+            let found = self.advance_step();
+            if let Some(d) = divergence_at(&self.net, self.step, self.leader.state(), found) {
+                self.refresh_states();
                 return Some(d);
             }
-            if sample_due(&self.net, self.step) && !self.sample(&mut on_sample) {
-                return None;
+            if sample_due(&self.net, self.step) {
+                self.refresh_states();
+                if !self.sample(&mut on_sample) {
+                    return None;
+                }
             }
         }
         None
@@ -231,6 +288,8 @@ impl InProcess {
         let plan = Plan {
             schedule: Schedule::new(net.coupling, net.steps),
             nbr_index,
+            sample_every: net.sample_every,
+            guard: &net.guard,
         };
         let from = *step;
         std::thread::scope(|scope| {
@@ -242,23 +301,25 @@ impl InProcess {
             }
             while *step < net.steps {
                 mine.step(&board, plan, *step, Some(leader));
-                crew::read_states(&board, states);
                 *step += 1;
-                if let Some(d) = guard::first(net, *step, leader.state(), states) {
+                let found = crew::read_found(&board);
+                if let Some(d) = divergence_at(net, *step, leader.state(), found) {
                     crew::release(&board, false);
                     return Some(d);
                 }
-                let due = sample_due(net, *step);
-                if due {
-                    sampled.0 = *step;
-                    crew::read_peaks(&board, &mut sampled.1);
+                if !plan.sample_due(*step) {
+                    crew::release(&board, true);
+                    continue;
                 }
+                sampled.0 = *step;
+                crew::read_peaks(&board, &mut sampled.1);
+                crew::read_states(&board, states);
                 let snapshot = Snapshot {
                     step: *step,
                     leader: leader.state(),
                     agents: states,
                 };
-                let go_on = !due || on_sample(&snapshot);
+                let go_on = on_sample(&snapshot);
                 crew::release(&board, go_on);
                 if !go_on {
                     return None;
@@ -269,7 +330,27 @@ impl InProcess {
     }
 }
 
+/// The divergence of the network at `step`: the leader's state if it is
+/// outside the envelope, else the first agent `found` outside it (index in
+/// `net.agents`, violation), as [`guard::first`] orders them.
+fn divergence_at(
+    net: &Network,
+    step: u64,
+    leader: &LeaderState,
+    found: Option<(usize, Violation)>,
+) -> Option<Divergence> {
+    let at = |node: u32, violation: Violation| Divergence {
+        step,
+        node,
+        violation,
+    };
+    match guard::check_leader(leader, &net.guard) {
+        Some(v) => Some(at(0, v)),
+        None => found.map(|(k, v)| at(net.agents[k].model.id, v)),
+    }
+}
+
 /// Whether the state after `step` steps is an output sample.
 fn sample_due(net: &Network, step: u64) -> bool {
-    step % net.sample_every == 0 || step == net.steps
+    crew::sample_due(net.sample_every, net.steps, step)
 }

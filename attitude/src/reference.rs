@@ -75,6 +75,9 @@ pub struct Leader {
     p: Matrix3<f64>,
     state: LeaderState,
     step: Rkmk4<1, 2>,
+    /// `step`'s current stage state, computed once per stage (published
+    /// and evaluated at).
+    stage_x: LeaderState,
     dt: f64,
 }
 
@@ -86,6 +89,7 @@ impl Leader {
             p,
             state,
             step: Rkmk4::new(state.to_lie(), dt),
+            stage_x: state,
             dt,
         }
     }
@@ -99,19 +103,22 @@ impl Leader {
     /// The leader's state at the current stage, as published.
     #[must_use]
     pub fn stage_exchange(&self) -> Exchanged {
-        LeaderState::from_lie(&self.step.stage_state()).exchanged()
+        self.stage_x.exchanged()
     }
 
     /// Evaluates the current stage and moves on; returns `true` when a step completed.
     pub fn advance(&mut self) -> bool {
-        let x = LeaderState::from_lie(&self.step.stage_state());
-        match self.step.push_derivative(&leader_field(&self.p, &x)) {
+        match self.step.push_derivative(&leader_field(&self.p, &self.stage_x)) {
             Some(next) => {
                 self.state = LeaderState::from_lie(&next);
                 self.step = Rkmk4::new(next, self.dt);
+                self.stage_x = self.state;
                 true
             }
-            None => false,
+            None => {
+                self.stage_x = LeaderState::from_lie(&self.step.stage_state());
+                false
+            }
         }
     }
 }

@@ -85,6 +85,21 @@ impl Schedule {
         self.slots().filter(|s| s.exchange)
     }
 
+    /// The stage after `slot` in the run (`None` after the run's last).
+    #[must_use]
+    pub fn next(&self, slot: Slot) -> Option<Slot> {
+        let (step, stage) = if slot.ends_step() {
+            (slot.step + 1, 0)
+        } else {
+            (slot.step, slot.stage + 1)
+        };
+        (step < self.steps).then(|| Slot {
+            step,
+            stage,
+            exchange: self.coupling.exchanges_at(step, stage as usize),
+        })
+    }
+
     /// The first exchange at or after step `n`, if any.
     #[must_use]
     pub fn first_exchange_from(&self, n: u64) -> Option<Slot> {
@@ -118,6 +133,18 @@ mod tests {
         let first = s.first_exchange_from(4).map(|x| (x.step, x.stage));
         assert_eq!(first, Some((6, 0)));
         assert_eq!(s.first_exchange_from(10), None);
+    }
+
+    #[test]
+    fn next_walks_the_slots_in_order() {
+        for coupling in [Coupling::Continuous, Coupling::Sampled { every: 3 }] {
+            let s = Schedule::new(coupling, 7);
+            let all: Vec<Slot> = s.slots().collect();
+            for (a, b) in all.iter().zip(&all[1..]) {
+                assert_eq!(s.next(*a), Some(*b));
+            }
+            assert_eq!(s.next(all[all.len() - 1]), None);
+        }
     }
 
     #[test]

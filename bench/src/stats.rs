@@ -53,6 +53,19 @@ fn own_ticks() -> Option<u64> {
     Some(f.get(11)? + f.get(12)? + f.get(13)? + f.get(14)?)
 }
 
+/// CPU time this process has used so far (user + system, every thread,
+/// finished ones included), s; `/proc` resolution (10 ms).
+#[must_use]
+pub fn cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let rest = &text[text.rfind(')')? + 2..];
+    let f: Vec<u64> = rest
+        .split_whitespace()
+        .map(|x| x.parse().unwrap_or(0))
+        .collect();
+    Some((f.get(11)? + f.get(12)?) as f64 / TICKS)
+}
+
 /// Measures how busy the machine was with *other* work during a
 /// measurement: machine CPU time minus this process's and its waited-for
 /// descendants' CPU time, per wall second (in cores).
@@ -152,6 +165,19 @@ mod tests {
         assert_eq!(median_u64(&[9, 1, 5]), Some(5));
         assert_eq!(median_u64(&[4, 1, 2, 3]), Some(2));
         assert_eq!(median_u64(&[]), None);
+    }
+
+    #[test]
+    fn cpu_seconds_grow_with_work() {
+        let Some(t0) = cpu_seconds() else {
+            assert!(!cfg!(target_os = "linux"));
+            return;
+        };
+        let mut x = 0u64;
+        while cpu_seconds().is_some_and(|t| t < t0 + 0.02) {
+            x = x.wrapping_add(1);
+        }
+        assert!(x > 0 && cpu_seconds().is_some_and(|t| t >= t0 + 0.02));
     }
 
     #[test]

@@ -5,8 +5,8 @@
 //! - the paper's three scenarios, stepped by the library on exactly 1, 2, 3
 //!   and 7 threads (one agent per thread at 7): every sampled state, peak
 //!   torque and link counter equal to the bit;
-//! - a generated 300-agent tree through `attsync run --threads N` (N = 1,
-//!   2, 3, 7): `errors.csv` and `states.bin` byte-identical, and
+//! - generated 300-agent trees (schemes 3 and 1) through `attsync run
+//!   --threads N` (N = 1, 2, 3, 7): `errors.csv` and `states.bin` byte-identical, and
 //!   `summary.json` records the threads used (7 asks for more than 300 / 64
 //!   allows: 4);
 //! - `--threads 0` is refused with exit code 2, naming the option.
@@ -81,6 +81,18 @@ fn summary_threads(dir: &Path) -> serde_json::Value {
 
 #[test]
 fn a_300_agent_tree_gives_byte_identical_results_for_any_thread_count() {
+    tree_results_are_byte_identical_for_any_thread_count("observerless");
+}
+
+#[test]
+fn a_300_agent_scheme_1_tree_gives_byte_identical_results_for_any_thread_count() {
+    tree_results_are_byte_identical_for_any_thread_count("observer-time-varying");
+}
+
+/// A generated 300-agent tree under `scheme` through `attsync run
+/// --threads 1/2/3/7`: `errors.csv` and `states.bin` byte-identical,
+/// `summary.json` naming the threads used.
+fn tree_results_are_byte_identical_for_any_thread_count(scheme: &str) {
     let tmp = tempfile::tempdir().expect("tempdir");
     let dir = tmp.path();
     let made = attsync(
@@ -95,7 +107,7 @@ fn a_300_agent_tree_gives_byte_identical_results_for_any_thread_count() {
             "--seed",
             "1",
             "--scheme",
-            "observerless",
+            scheme,
             "--duration",
             "0.3",
             "--out",
@@ -133,7 +145,7 @@ fn a_300_agent_tree_gives_byte_identical_results_for_any_thread_count() {
         assert!(files.0.len() > 300 * 30 && !files.1.is_empty());
         match &first {
             None => first = Some(files),
-            Some(f) => assert!(*f == files, "--threads {threads}: results differ"),
+            Some(f) => assert!(*f == files, "{scheme}, --threads {threads}: results differ"),
         }
     }
 }

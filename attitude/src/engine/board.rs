@@ -97,6 +97,13 @@ impl Words<EXCHANGED> for Exchanged {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Judged(pub Exchanged, pub bool);
 
+impl Default for Judged {
+    /// Nothing published yet: the identity, not trusted.
+    fn default() -> Self {
+        Self(Exchanged::identity(), false)
+    }
+}
+
 impl Judged {
     /// `x` with its verdict.
     #[must_use]

@@ -2,35 +2,43 @@
 //! stepping a contiguous chunk of the agents; the calling thread steps the
 //! first chunk and the leader.
 //!
-//! Per exchange, one barrier: every thread publishes its nodes' stage
-//! states into one of two buffers (alternating, so nobody overwrites a
-//! buffer another thread may still read), waits, then reads its inputs
-//! from that buffer and advances. Per step, two more: the step's end
-//! (every agent's state on the board, so the caller can sample or check
-//! them) and the go-ahead (the caller is done with them, or says stop).
+//! Per exchange, one barrier: every value of the exchange is on the board
+//! (two buffers, alternating, so nobody overwrites a buffer another thread
+//! may still read); after it each thread runs one [`pass`] over its agents
+//! (receive, advance, publish the next exchange's value into the other
+//! buffer). Per step, two more: the step's end (each share's first agent
+//! outside the envelope, checked in its pass, and at a sample every
+//! agent's state and peak torque, on the board for the caller) and the
+//! go-ahead (the caller is done with them, or says stop).
 //!
 //! Every agent does exactly the arithmetic of the one-thread loop, on the
 //! same values in the same order, so the trajectories are bit-identical
 //! for any number of threads.
 
 use super::barrier::SpinBarrier;
-use super::board::{AGENT_STATE, JUDGED, Judged, Slot, slots};
+use super::board::{AGENT_STATE, JUDGED, Judged, Slot as Shared, slots};
+use super::pass::{Stage, pass};
 use crate::agent::Agent;
+use crate::guard::{Envelope, Violation};
 use crate::network::AgentState;
 use crate::reference::Leader;
-use crate::schedule::Schedule;
+use crate::schedule::{Schedule, Slot};
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering::SeqCst};
 
 /// What the threads share.
 #[derive(Debug)]
 pub(super) struct Board {
-    /// Published stage states, two buffers used in turn: agents in network
-    /// order, then the leader.
-    published: [Vec<Slot<JUDGED>>; 2],
-    /// Every agent's state at the end of the last step.
-    states: Vec<Slot<AGENT_STATE>>,
-    /// Every agent's peak torque at the end of the last step.
-    peaks: Vec<Slot<1>>,
+    /// Published stage states, two buffers used in turn (exchange k reads
+    /// buffer k mod 2): agents in network order, then the leader.
+    published: [Vec<Shared<JUDGED>>; 2],
+    /// Every agent's state at the end of the last sampled step.
+    states: Vec<Shared<AGENT_STATE>>,
+    /// Every agent's peak torque at the end of the last sampled step.
+    peaks: Vec<Shared<1>>,
+    /// Per share, the first agent (network index) outside the envelope
+    /// after the last step, if any.
+    found: Vec<Mutex<Option<(usize, Violation)>>>,
     barrier: SpinBarrier,
     stop: AtomicBool,
 }
@@ -42,6 +50,7 @@ impl Board {
             published: [slots(agents + 1), slots(agents + 1)],
             states: slots(agents),
             peaks: slots(agents),
+            found: (0..threads).map(|_| Mutex::new(None)).collect(),
             barrier: SpinBarrier::new(threads),
             stop: AtomicBool::new(false),
         }
@@ -55,15 +64,36 @@ pub(super) struct Plan<'a> {
     pub schedule: Schedule,
     /// For each agent, the index of each neighbour.
     pub nbr_index: &'a [Vec<usize>],
+    /// Output sample period, steps.
+    pub sample_every: u64,
+    /// The envelope every state is checked against after every step.
+    pub guard: &'a Envelope,
+}
+
+impl Plan<'_> {
+    /// Whether the state after `step` steps is an output sample.
+    pub(super) fn sample_due(&self, step: u64) -> bool {
+        sample_due(self.sample_every, self.schedule.steps(), step)
+    }
+}
+
+/// Whether the state after `step` of `steps` steps is an output sample
+/// (one every `sample_every` steps, and the last).
+pub(super) fn sample_due(sample_every: u64, steps: u64, step: u64) -> bool {
+    step % sample_every == 0 || step == steps
 }
 
 /// One thread's agents: `agents[0]` is agent `first` of the network.
 #[derive(Debug)]
 pub(super) struct Share<'a> {
+    /// This share's place among the shares.
+    index: usize,
     first: usize,
     agents: &'a mut [Agent],
-    /// Which published buffer the next exchange uses.
+    /// Which published buffer the next exchange reads.
     parity: usize,
+    /// The exchange (step, stage) whose values this share's last pass published.
+    ready: Option<(u64, u32)>,
 }
 
 impl<'a> Share<'a> {
@@ -78,9 +108,11 @@ impl<'a> Share<'a> {
                 let (chunk, tail) = std::mem::take(&mut rest).split_at_mut(len);
                 rest = tail;
                 let share = Share {
+                    index: k,
                     first,
                     agents: chunk,
                     parity: 0,
+                    ready: None,
                 };
                 first += len;
                 share
@@ -89,8 +121,10 @@ impl<'a> Share<'a> {
     }
 
     /// Steps this share's agents (and the leader, on the thread that has
-    /// it) through step `n`, then puts their states on the board and
-    /// waits for every thread (the step's end).
+    /// it) through step `n`, one [`pass`] per stage, then leaves on the
+    /// board what the caller reads (the first agent outside the envelope;
+    /// states and peak torques if the step is sampled) and waits for every
+    /// thread (the step's end).
     pub(super) fn step(
         &mut self,
         board: &Board,
@@ -99,16 +133,69 @@ impl<'a> Share<'a> {
         leader: Option<&mut Leader>,
     ) {
         let mut leader = leader;
+        let mut found = None;
         for slot in plan.schedule.stages(n) {
-            if slot.exchange {
-                self.exchange(board, plan, leader.as_deref());
-            }
+            let from_leader = slot
+                .exchange
+                .then(|| self.exchange(board, slot, leader.as_deref()));
             if let Some(l) = leader.as_deref_mut() {
                 l.advance();
             }
-            for agent in self.agents.iter_mut() {
-                agent.advance();
+            let next = plan.schedule.next(slot).filter(|x| x.exchange);
+            let stage = Stage {
+                leader: from_leader,
+                publish: next.is_some(),
+                check: slot.ends_step().then_some(plan.guard),
+            };
+            // Read this exchange's buffer; write the next exchange's (the
+            // other one at an exchange).
+            let read = &board.published[self.parity];
+            if slot.exchange {
+                self.parity ^= 1;
             }
+            let out = &board.published[self.parity][self.first..];
+            let nbrs = &plan.nbr_index[self.first..];
+            found = pass(
+                self.agents,
+                nbrs,
+                stage,
+                |j| read[j].load(),
+                |k, x| out[k].store(&x),
+            );
+            if let Some(x) = next {
+                self.ready = Some((x.step, x.stage));
+            }
+        }
+        self.leave(board, plan.sample_due(n + 1), found);
+        board.barrier.wait();
+    }
+
+    /// One exchange's meeting: publish (the leader's value, and this
+    /// share's unless its last pass did), wait for everyone, then the
+    /// leader's value as published.
+    fn exchange(&self, board: &Board, slot: Slot, leader: Option<&Leader>) -> Judged {
+        let buffer = &board.published[self.parity];
+        let leader_slot = &buffer[buffer.len() - 1];
+        if let Some(l) = leader {
+            leader_slot.store(&Judged::of(l.stage_exchange()));
+        }
+        if self.ready != Some((slot.step, slot.stage)) {
+            for (cell, agent) in buffer[self.first..].iter().zip(self.agents.iter()) {
+                cell.store(&Judged::of(agent.stage_exchange()));
+            }
+        }
+        board.barrier.wait();
+        leader_slot.load()
+    }
+
+    /// Leaves on the board, after a step, this share's first agent outside
+    /// the envelope and, if the step is sampled, its states and peak torques.
+    fn leave(&self, board: &Board, sampled: bool, found: Option<(usize, Violation)>) {
+        if let Some((k, v)) = found {
+            *lock(&board.found[self.index]) = Some((self.first + k, v));
+        }
+        if !sampled {
+            return;
         }
         for (slot, agent) in board.states[self.first..].iter().zip(self.agents.iter()) {
             slot.store(agent.state());
@@ -116,31 +203,11 @@ impl<'a> Share<'a> {
         for (slot, agent) in board.peaks[self.first..].iter().zip(self.agents.iter()) {
             slot.store(&agent.peak_torque());
         }
-        board.barrier.wait();
     }
+}
 
-    /// One exchange: publish, wait for everyone, receive.
-    fn exchange(&mut self, board: &Board, plan: Plan<'_>, leader: Option<&Leader>) {
-        let buffer = &board.published[self.parity];
-        self.parity ^= 1;
-        let leader_slot = &buffer[buffer.len() - 1];
-        if let Some(l) = leader {
-            leader_slot.store(&Judged::of(l.stage_exchange()));
-        }
-        for (slot, agent) in buffer[self.first..].iter().zip(self.agents.iter()) {
-            slot.store(&Judged::of(agent.stage_exchange()));
-        }
-        board.barrier.wait();
-        let Judged(from_leader, leader_trusted) = leader_slot.load();
-        let nbrs = &plan.nbr_index[self.first..];
-        for (agent, nbrs) in self.agents.iter_mut().zip(nbrs) {
-            for (k, &j) in nbrs.iter().enumerate() {
-                let Judged(x, trusted) = buffer[j].load();
-                agent.receive_neighbour_judged(k, x, trusted);
-            }
-            agent.receive_leader_judged(from_leader, leader_trusted);
-        }
-    }
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// A worker thread: steps its share from step `from` until the end or
@@ -155,15 +222,21 @@ pub(super) fn work(mut share: Share<'_>, board: &Board, plan: Plan<'_>, from: u6
     }
 }
 
-/// The caller's side after a step's end: reads every agent's state into
-/// `states`.
+/// The caller's side after a step's end: the first agent outside the
+/// envelope (network index, violation), shares in order.
+pub(super) fn read_found(board: &Board) -> Option<(usize, Violation)> {
+    board.found.iter().find_map(|f| *lock(f))
+}
+
+/// The caller's side after a sampled step's end: reads every agent's state
+/// into `states`.
 pub(super) fn read_states(board: &Board, states: &mut [AgentState]) {
     for (s, slot) in states.iter_mut().zip(&board.states) {
         *s = slot.load();
     }
 }
 
-/// The caller's side after a step's end: every agent's peak torque into `peaks`.
+/// The caller's side after a sampled step's end: every agent's peak torque into `peaks`.
 pub(super) fn read_peaks(board: &Board, peaks: &mut Vec<f64>) {
     peaks.clear();
     peaks.extend(board.peaks.iter().map(|slot| slot.load::<f64>()));

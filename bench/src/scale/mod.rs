@@ -6,7 +6,10 @@
 //! [`MIN_STEPS`] steps) after one untimed warm-up step, and reports
 //! agent-steps/s = N × steps ÷ wall s, with `threads` the count the engine
 //! used ([`attitude::engine::InProcess::with_threads`] gives each thread at
-//! least 64 agents, `--exact` lifts that).
+//! least 64 agents, `--exact` lifts that), agent-steps per CPU second (the
+//! process's CPU time: on one thread the per-core figure, which a busy
+//! machine disturbs less than the wall clock; on several it counts the
+//! barriers' spinning too) and each thread count's speed-up over the first.
 //!
 //! # Layout
 //! - [`tree`]: the binary tree of any size.
@@ -39,6 +42,8 @@ pub struct Figure {
     pub steps: u64,
     /// Wall time of the timed steps, s.
     pub seconds: f64,
+    /// CPU time of the timed steps (every thread), s, if `/proc` tells.
+    pub cpu_seconds: Option<f64>,
     /// Whether every agent's final state is finite (the run did not diverge).
     pub finite: bool,
 }
@@ -46,7 +51,16 @@ pub struct Figure {
 impl Figure {
     /// Agent-steps per second.
     pub fn agent_steps_per_s(&self) -> f64 {
-        f64::from(self.agents) * self.steps as f64 / self.seconds
+        self.agent_steps() / self.seconds
+    }
+
+    /// Agent-steps per CPU second (`None` if unknown or under `/proc`'s resolution).
+    pub fn agent_steps_per_cpu_s(&self) -> Option<f64> {
+        (self.cpu_seconds).and_then(|c| (c > 0.0).then(|| self.agent_steps() / c))
+    }
+
+    fn agent_steps(&self) -> f64 {
+        f64::from(self.agents) * self.steps as f64
     }
 }
 
@@ -63,6 +77,7 @@ pub fn measure(scheme: SchemeArg, agents: u32, threads: usize, exact: bool, budg
         engine.with_threads(threads)
     };
     engine.step();
+    let cpu = crate::stats::cpu_seconds();
     let started = Instant::now();
     let mut finite = true;
     engine.run(|snap| {
@@ -81,19 +96,24 @@ pub fn measure(scheme: SchemeArg, agents: u32, threads: usize, exact: bool, budg
         threads: engine.threads(),
         steps,
         seconds: started.elapsed().as_secs_f64(),
+        cpu_seconds: cpu.zip(crate::stats::cpu_seconds()).map(|(a, b)| b - a),
         finite,
     }
 }
 
-/// The Markdown table of `figures`: one row per (scheme, N), one column
-/// per thread count asked.
+/// The Markdown table of `figures`: one row per (scheme, N); per thread
+/// count asked, agent-steps/s (threads used) and agent-steps per CPU s;
+/// then the speed-up of each further thread count over the first.
 pub fn table(figures: &[Figure], threads: &[usize]) -> String {
     let mut s = String::from("| scheme | N | steps |");
     for t in threads {
-        let _ = write!(s, " threads {t}: agent-steps/s (used) |");
+        let _ = write!(s, " threads {t}: agent-steps/s (used) | per CPU s |");
+    }
+    for t in &threads[1..] {
+        let _ = write!(s, " speed-up {t}/{} |", threads[0]);
     }
     s.push_str("\n|---|---:|---:|");
-    for _ in threads {
+    for _ in threads.iter().chain(threads).chain(&threads[1..]) {
         s.push_str("---:|");
     }
     let mut rows: Vec<(SchemeArg, u32)> = figures.iter().map(|f| (f.scheme, f.agents)).collect();
@@ -107,17 +127,36 @@ pub fn table(figures: &[Figure], threads: &[usize]) -> String {
         let steps = of(threads[0]).map_or(0, |f| f.steps);
         let _ = write!(s, "\n| {} | {n} | {steps} |", scheme.name());
         for &t in threads {
-            match of(t) {
-                Some(f) => {
-                    let mark = if f.finite { "" } else { " (diverged)" };
-                    let _ = write!(s, " {:.3e} ({}){mark} |", f.agent_steps_per_s(), f.threads);
+            s.push_str(&cells(of(t)));
+        }
+        let base = of(threads[0]).map(Figure::agent_steps_per_s);
+        for &t in &threads[1..] {
+            match (base, of(t)) {
+                (Some(b), Some(f)) => {
+                    let _ = write!(s, " {:.2} |", f.agent_steps_per_s() / b);
                 }
-                None => s.push_str(" – |"),
+                _ => s.push_str(" – |"),
             }
         }
     }
     s.push('\n');
     s
+}
+
+/// The two cells of one figure: agent-steps/s (threads used) and per CPU s.
+fn cells(f: Option<&Figure>) -> String {
+    let Some(f) = f else {
+        return " – | – |".into();
+    };
+    let mark = if f.finite { "" } else { " (diverged)" };
+    let cpu = f
+        .agent_steps_per_cpu_s()
+        .map_or("–".into(), |r| format!("{r:.3e}"));
+    format!(
+        " {:.3e} ({}){mark} | {cpu} |",
+        f.agent_steps_per_s(),
+        f.threads
+    )
 }
 
 #[cfg(test)]
@@ -162,6 +201,8 @@ mod tests {
         assert!(f.finite && f.steps == BUDGET / 10 && f.seconds > 0.0);
         let t = table(&[f], &[2, 1]);
         assert!(t.contains("| observerless | 10 | 200000 |"), "{t}");
-        assert!(t.contains("(2) |") && t.contains(" – |"), "{t}");
+        assert!(t.contains("(2) |") && t.contains(" – | – | – |"), "{t}");
+        assert!(t.contains("| speed-up 1/2 |"), "{t}");
+        assert_eq!(t.lines().nth(1).map(|l| l.matches(":|").count()), Some(7), "{t}");
     }
 }

@@ -1,0 +1,61 @@
+//! One stage of a run of agents, in one pass: each agent receives its
+//! inputs (at an exchange), advances, publishes its next stage state (when
+//! the next stage is an exchange) and, at the end of a step, is checked
+//! against the envelope ([`crate::guard`]). Each agent's data is touched
+//! once per stage, while it is in the cache.
+//!
+//! Both the one-thread step and every thread of the crew run this pass:
+//! the same calls on each agent, in the same order, as receiving for
+//! every agent, then advancing every agent, then publishing and checking
+//! every agent (an agent's calls touch only its own state), so the
+//! results are those of separate passes, bit for bit.
+
+use super::board::Judged;
+use crate::agent::Agent;
+use crate::guard::{Envelope, Violation, check_agent};
+
+/// What a stage's pass does besides advancing every agent.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Stage<'a> {
+    /// At an exchange: the leader's published value (every agent then
+    /// receives its inputs first).
+    pub leader: Option<Judged>,
+    /// Whether the next stage is an exchange (every agent then publishes
+    /// its new stage state).
+    pub publish: bool,
+    /// At the end of a step: the envelope every agent's new state is
+    /// checked against.
+    pub check: Option<&'a Envelope>,
+}
+
+/// Runs `stage` over `agents` (`nbr_index[k]`: the network indices of agent
+/// `k`'s neighbours). `read(j)` is the value agent `j` of the network
+/// published for this exchange; `write(k, x)` publishes agent `k`'s value
+/// for the next one. Returns the first agent (index in `agents`) whose new
+/// state is outside the envelope, and its violation.
+pub(super) fn pass(
+    agents: &mut [Agent],
+    nbr_index: &[Vec<usize>],
+    stage: Stage<'_>,
+    read: impl Fn(usize) -> Judged,
+    mut write: impl FnMut(usize, Judged),
+) -> Option<(usize, Violation)> {
+    let mut first = None;
+    for (k, (agent, nbrs)) in agents.iter_mut().zip(nbr_index).enumerate() {
+        if let Some(Judged(from_leader, trusted)) = stage.leader {
+            for (m, &j) in nbrs.iter().enumerate() {
+                let Judged(x, ok) = read(j);
+                agent.receive_neighbour_judged(m, x, ok);
+            }
+            agent.receive_leader_judged(from_leader, trusted);
+        }
+        agent.advance();
+        if stage.publish {
+            write(k, Judged::of(agent.stage_exchange()));
+        }
+        if let Some(env) = stage.check.filter(|_| first.is_none()) {
+            first = check_agent(agent.state(), env).map(|v| (k, v));
+        }
+    }
+    first
+}
