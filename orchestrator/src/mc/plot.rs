@@ -6,6 +6,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
+/// Which settle time of a trial a curve shows.
+type Pick = fn(&TrialResult) -> Option<f64>;
+
 /// Smallest error drawn (exact zeros and smaller are put in its bin).
 const FLOOR: f64 = 1e-16;
 
@@ -55,7 +58,7 @@ fn ecdf<DB: DrawingBackend>(
         .x_desc("settle time (s)")
         .draw()
         .map_err(|e| e.to_string())?;
-    let curves: [(&str, fn(&TrialResult) -> Option<f64>, RGBColor); 2] = [
+    let curves: [(&str, Pick, RGBColor); 2] = [
         ("to 1e-3", |r| r.settle_1e3, BLUE),
         ("to 1e-6", |r| r.settle_1e6, RED),
     ];
