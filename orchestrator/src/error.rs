@@ -54,6 +54,9 @@ pub enum Error {
         /// The OS error.
         source: std::io::Error,
     },
+    /// A Monte Carlo produced no results (or was interrupted).
+    #[error(transparent)]
+    Mc(#[from] crate::mc::McError),
     /// The signal handler could not be installed.
     #[error("installing the signal handler: {0}")]
     Signals(std::io::Error),
@@ -74,6 +77,7 @@ impl Error {
                 SweepError::Run { source, .. } => run_code(source),
                 _ => 1,
             },
+            Error::Mc(e) => e.exit_code(),
             _ => 1,
         }
     }
@@ -84,7 +88,9 @@ impl Error {
     pub fn is_scenario(&self) -> bool {
         matches!(
             self,
-            Error::Scenario(_) | Error::Sweep(SweepError::Scenario(_))
+            Error::Scenario(_)
+                | Error::Sweep(SweepError::Scenario(_))
+                | Error::Mc(crate::mc::McError::Scenario(_))
         )
     }
 }

@@ -128,6 +128,7 @@ pub fn tree(p: &TreeParams) -> Result<Generated, String> {
         edges,
         network: Default::default(),
         guard: Default::default(),
+        monte_carlo: None,
     };
     let mut notes: Vec<String> = [pick_gains(&mut scenario), pick_dt(&mut scenario)]
         .into_iter()

@@ -9,6 +9,7 @@
 //! - [`results`]: `errors.csv`, `summary.json`, `errors.svg`, atomic output.
 //! - [`sweep`]: one field over many values, and the bisection for the margin.
 //! - [`generate`]: generated scenarios (random trees).
+//! - [`mc`]: the Monte Carlo over initial conditions (`attsync mc`).
 //! - [`conform`]: the conformance check of a plug-in agent program.
 //! - [`options`]: range checks of command-line options, before anything starts.
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
@@ -21,6 +22,7 @@ pub mod conform;
 pub mod error;
 pub mod generate;
 pub mod interrupt;
+pub mod mc;
 pub mod options;
 pub mod outcome;
 pub mod processes;

@@ -15,6 +15,10 @@
 //!   .attsync-run  summary.json    marker; summary.json has the content of sweep.json
 //!   sweep.csv  sweep.json  sweep.svg
 //!   runs/<k>-<value>/             one run each (the run layout above)
+//! results/<scenario>-mc/          a Monte Carlo (`attsync mc`, default --out)
+//!   .attsync-run                  marker
+//!   trials.csv  initial.csv  mc.json  mc.svg
+//!   logs/trial-<k>/<node>.log     processes engine: the logs of a trial that failed
 //! .<name>.partial-<pid>/          staging directory beside `<name>` while it is written
 //! .<name>.partial-<pid>.old/      the replaced results, while the new ones move in
 //! .<name>.lock                    held (flock) by the run writing `<name>`; removed after
@@ -46,13 +50,34 @@ pub const SWEEP_JSON: &str = "sweep.json";
 pub const SWEEP_SVG: &str = "sweep.svg";
 /// `runs/`: a sweep's runs.
 pub const RUNS: &str = "runs";
+/// `trials.csv`: a Monte Carlo's trials.
+pub const TRIALS_CSV: &str = "trials.csv";
+/// `initial.csv`: a Monte Carlo's draws.
+pub const INITIAL_CSV: &str = "initial.csv";
+/// `mc.json`: a Monte Carlo's summary.
+pub const MC_JSON: &str = "mc.json";
+/// `mc.svg`: a Monte Carlo's plot.
+pub const MC_SVG: &str = "mc.svg";
 /// Default parent of results directories (relative to the working directory).
 pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
-pub const OWNED: [&str; 11] = [
-    MARKER, SUMMARY, ERRORS_CSV, ERRORS_SVG, STATES, SCENARIO, LOGS, SWEEP_CSV, SWEEP_JSON,
-    SWEEP_SVG, RUNS,
+pub const OWNED: [&str; 15] = [
+    MARKER,
+    SUMMARY,
+    ERRORS_CSV,
+    ERRORS_SVG,
+    STATES,
+    SCENARIO,
+    LOGS,
+    SWEEP_CSV,
+    SWEEP_JSON,
+    SWEEP_SVG,
+    RUNS,
+    TRIALS_CSV,
+    INITIAL_CSV,
+    MC_JSON,
+    MC_SVG,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
@@ -248,6 +273,56 @@ impl SweepLayout {
     pub fn run(&self, k: usize, value: &str) -> RunLayout {
         RunLayout::new(self.runs().join(sweep_run_name(k, value)))
     }
+}
+
+/// The files of a Monte Carlo's directory.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct McLayout {
+    root: PathBuf,
+}
+
+impl McLayout {
+    /// The layout of Monte Carlo directory `root` (which may be a staging directory).
+    #[must_use]
+    pub fn new(root: impl Into<PathBuf>) -> Self {
+        Self { root: root.into() }
+    }
+
+    /// `trials.csv`.
+    #[must_use]
+    pub fn trials(&self) -> PathBuf {
+        self.root.join(TRIALS_CSV)
+    }
+
+    /// `initial.csv`.
+    #[must_use]
+    pub fn initial(&self) -> PathBuf {
+        self.root.join(INITIAL_CSV)
+    }
+
+    /// `mc.json`.
+    #[must_use]
+    pub fn json(&self) -> PathBuf {
+        self.root.join(MC_JSON)
+    }
+
+    /// `mc.svg`.
+    #[must_use]
+    pub fn svg(&self) -> PathBuf {
+        self.root.join(MC_SVG)
+    }
+
+    /// `logs/trial-<k>/`: the node logs of trial `k` (processes engine).
+    #[must_use]
+    pub fn trial_logs(&self, k: u64) -> PathBuf {
+        self.root.join(LOGS).join(format!("trial-{k}"))
+    }
+}
+
+/// `results/<scenario>-mc`: a Monte Carlo's default directory.
+#[must_use]
+pub fn default_mc_dir(scenario: &str) -> PathBuf {
+    Path::new(RESULTS).join(format!("{scenario}-mc"))
 }
 
 /// `dest`'s parent (`.` for a bare name), where its staging directories and

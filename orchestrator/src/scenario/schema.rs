@@ -38,6 +38,9 @@ pub struct Scenario {
     /// The envelope of a sane state (default: `attitude::guard::Envelope::default`).
     #[serde(default, skip_serializing_if = "GuardSpec::is_unset")]
     pub guard: GuardSpec,
+    /// `[monte_carlo]`: what `attsync mc` disperses (ignored by other commands).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub monte_carlo: Option<crate::mc::MonteCarloSpec>,
 }
 
 /// `[guard]`: the largest norms a node's state may reach before the run

@@ -5,6 +5,7 @@ mod check;
 mod conform;
 mod export;
 mod r#gen;
+mod mc;
 mod run;
 mod sweep;
 
@@ -36,6 +37,10 @@ pub enum Command {
     Export(export::Export),
     /// Generate a scenario.
     Gen(r#gen::GenCmd),
+    /// Monte Carlo over initial conditions: N trials from Haar-uniform
+    /// attitudes and random rates, each classified; the failure rate with
+    /// its exact 95 % bound. `--trial K` reruns one trial alone.
+    Mc(mc::Mc),
 }
 
 /// Runs `command`.
@@ -47,6 +52,7 @@ pub fn exec(command: Command) -> Result<(), Error> {
         Command::Conform(a) => conform::exec(a),
         Command::Export(a) => export::exec(a),
         Command::Gen(a) => r#gen::exec(a),
+        Command::Mc(a) => mc::exec(a, &interrupt()?),
     }
 }
 

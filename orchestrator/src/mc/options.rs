@@ -1,0 +1,57 @@
+//! [`McOptions`]: what `attsync mc` runs and how.
+
+use crate::options::{self, OptionError, StiffnessCheck};
+use crate::processes::ProcessOptions;
+use crate::run::Engine;
+use std::path::PathBuf;
+
+/// Default `--tolerance`: final `|Rᵢ R₀ᵀ|_I` and `‖ωᵢ − ω₀‖` (rad/s) below
+/// it (chosen by measurement on the paper's scenarios, README "Monte Carlo").
+pub const DEFAULT_TOLERANCE: f64 = 1e-4;
+
+/// A Monte Carlo's options.
+#[derive(Debug, Clone)]
+pub struct McOptions {
+    /// Scenario file.
+    pub scenario: PathBuf,
+    /// `--set` overrides of every trial.
+    pub set: Vec<String>,
+    /// Number of trials (≥ 1).
+    pub trials: u64,
+    /// Master seed.
+    pub seed: u64,
+    /// Trials at once (≥ 1).
+    pub jobs: usize,
+    /// Engine of each trial (in-process: on one thread).
+    pub engine: Engine,
+    /// Process-engine options.
+    pub processes: ProcessOptions,
+    /// Convergence tolerance (> 0).
+    pub tolerance: f64,
+    /// Results directory.
+    pub out: PathBuf,
+    /// Draw a progress bar on stderr.
+    pub progress: bool,
+    /// `--no-stiffness-check`.
+    pub stiffness: StiffnessCheck,
+}
+
+impl McOptions {
+    /// Checks `--trials`, `--jobs`, `--tolerance` and the process engine's timeouts.
+    ///
+    /// # Errors
+    /// The first option out of its range.
+    pub fn validate(&self) -> Result<(), OptionError> {
+        options::count("--trials", self.trials, 1, u64::MAX)?;
+        options::count("--jobs", self.jobs as u64, 1, u64::MAX)?;
+        options::positive("--tolerance", self.tolerance)?;
+        options::seconds("--stage-timeout", self.processes.stage_timeout)?;
+        options::seconds("--start-timeout", self.processes.start_timeout)
+    }
+}
+
+/// The default results directory: `results/<scenario name>-mc`.
+#[must_use]
+pub fn default_out(scenario_name: &str) -> PathBuf {
+    crate::results::layout::default_mc_dir(scenario_name)
+}

@@ -1,0 +1,281 @@
+//! A Monte Carlo's files and table: `trials.csv` (one row per trial),
+//! `initial.csv` (the draws, one row per trial and node), `mc.json`
+//! ([`McSummary`]) and the summary table printed on stdout. Every number is
+//! written in Rust's shortest round-trip form; nothing depends on `--jobs`
+//! or on the wall clock, so the files are identical for any `--jobs`.
+
+use super::dispersion::{Dispersion, LeaderDispersion, Quantity};
+use super::draws::Draws;
+use super::outcome::{Outcome, TrialResult};
+use super::stats;
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// The exact header of `trials.csv`.
+pub const TRIALS_HEADER: &str =
+    "trial,seed,outcome,final_max_att_err,final_max_angvel_err,t_end,settle_1e-3,settle_1e-6";
+
+/// The exact header of `initial.csv`.
+pub const INITIAL_HEADER: &str = "trial,agent,q_w,q_x,q_y,q_z,omega_x,omega_y,omega_z,qhat_w,qhat_x,qhat_y,qhat_z,omegahat_x,omegahat_y,omegahat_z,sigmahat_x,sigmahat_y,sigmahat_z";
+
+/// Confidence of the bounds in `mc.json`.
+pub const CONFIDENCE: f64 = 0.95;
+
+/// Trials listed in `mc.json` `slowest`.
+pub const SLOWEST: usize = 10;
+
+fn opt(x: Option<f64>) -> String {
+    x.map_or(String::new(), |v| v.to_string())
+}
+
+/// One `trials.csv` row (no newline).
+#[must_use]
+pub fn trial_row(r: &TrialResult) -> String {
+    format!(
+        "{},{},{},{},{},{},{},{}",
+        r.trial,
+        r.seed,
+        r.outcome.name(),
+        r.final_max_att_err,
+        r.final_max_angvel_err,
+        r.t_end,
+        opt(r.settle_1e3),
+        opt(r.settle_1e6)
+    )
+}
+
+/// `trials.csv`.
+#[must_use]
+pub fn trials_csv(results: &[TrialResult]) -> String {
+    let mut s = format!("{TRIALS_HEADER}\n");
+    for r in results {
+        s += &trial_row(r);
+        s.push('\n');
+    }
+    s
+}
+
+/// The cells of `values` if `drawn`, else as many empty cells.
+fn cells(s: &mut String, values: &[f64], drawn: bool) {
+    for v in values {
+        s.push(',');
+        if drawn {
+            let _ = write!(s, "{v}");
+        }
+    }
+}
+
+/// `initial.csv` rows of one trial: one per agent (its id) and, if the
+/// leader is dispersed, one for it (agent 0; `sigmahat_*` hold `σ₀(0)`).
+/// A value that is not dispersed is left empty (it is the scenario's).
+pub fn initial_rows(s: &mut String, trial: u64, ids: &[u32], d: &Dispersion, draws: &Draws) {
+    for (id, a) in ids.iter().zip(&draws.agents) {
+        let _ = write!(s, "{trial},{id}");
+        cells(s, &a.attitude, d.has(Quantity::Attitude));
+        cells(s, &a.omega, d.has(Quantity::Omega));
+        cells(s, &a.attitude_hat, d.has(Quantity::AttitudeHat));
+        cells(s, &a.omega_hat, d.has(Quantity::OmegaHat));
+        cells(s, &a.sigma_hat, d.has(Quantity::SigmaHat));
+        s.push('\n');
+    }
+    if d.leader != LeaderDispersion::None {
+        let l = &draws.leader;
+        let state = d.leader == LeaderDispersion::State;
+        let _ = write!(s, "{trial},0");
+        cells(s, &l.attitude, true);
+        cells(s, &l.omega, state);
+        cells(s, &l.attitude_hat, false);
+        cells(s, &l.omega_hat, false);
+        cells(s, &l.sigma_hat, state);
+        s.push('\n');
+    }
+}
+
+/// Counts of each outcome.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct Counts {
+    /// Converged.
+    pub converged: u64,
+    /// Not converged.
+    pub not_converged: u64,
+    /// Diverged.
+    pub diverged: u64,
+    /// Failed (a process).
+    pub failed: u64,
+}
+
+impl Counts {
+    /// The counts of `results`.
+    #[must_use]
+    pub fn of(results: &[TrialResult]) -> Self {
+        let mut c = Counts::default();
+        for r in results {
+            *c.get_mut(r.outcome) += 1;
+        }
+        c
+    }
+
+    fn get_mut(&mut self, o: Outcome) -> &mut u64 {
+        match o {
+            Outcome::Converged => &mut self.converged,
+            Outcome::NotConverged => &mut self.not_converged,
+            Outcome::Diverged => &mut self.diverged,
+            Outcome::Failed => &mut self.failed,
+        }
+    }
+
+    /// The count of outcome `o`.
+    #[must_use]
+    pub fn get(&self, o: Outcome) -> u64 {
+        match o {
+            Outcome::Converged => self.converged,
+            Outcome::NotConverged => self.not_converged,
+            Outcome::Diverged => self.diverged,
+            Outcome::Failed => self.failed,
+        }
+    }
+}
+
+/// `mc.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct McSummary {
+    /// attsync's version.
+    pub attsync_version: String,
+    /// The scenario's name.
+    pub scenario: String,
+    /// Engine of the trials.
+    pub engine: String,
+    /// The master seed.
+    pub seed: u64,
+    /// Trials asked for.
+    pub trials: u64,
+    /// Trials that ran to an outcome (fewer if interrupted).
+    pub trials_run: u64,
+    /// Whether every trial asked for ran.
+    pub complete: bool,
+    /// Simulated horizon of each trial, s.
+    pub duration: f64,
+    /// The convergence tolerance on the final attitude and angular-velocity errors.
+    pub tolerance: f64,
+    /// The criterion, in words.
+    pub criterion: String,
+    /// What was dispersed.
+    pub dispersion: Dispersion,
+    /// Trials of each outcome.
+    pub counts: Counts,
+    /// Trials that did not converge (not converged, diverged or failed).
+    pub failures: u64,
+    /// `failures / trials_run`.
+    pub failure_rate: f64,
+    /// The exact one-sided 95 % Clopper–Pearson upper bound of the failure rate.
+    pub failure_rate_upper_95: f64,
+    /// The exact two-sided 95 % Clopper–Pearson interval of the failure rate.
+    pub failure_rate_interval_95: [f64; 2],
+    /// Indices of the trials that did not converge.
+    pub failed_trials: Vec<u64>,
+    /// The slowest trials (latest settle time to 1e-6; never settled first).
+    pub slowest: Vec<TrialResult>,
+}
+
+/// The summary of `results` (by trial index).
+#[must_use]
+pub fn summarise(head: McSummary, results: &[TrialResult]) -> McSummary {
+    let counts = Counts::of(results);
+    let n = results.len() as u64;
+    let failures = n - counts.converged;
+    let alpha = 1.0 - CONFIDENCE;
+    let (upper, interval) = if n == 0 {
+        (1.0, [0.0, 1.0])
+    } else {
+        let (lo, hi) = stats::interval(failures, n, alpha);
+        (stats::upper_bound(failures, n, alpha), [lo, hi])
+    };
+    let mut slowest: Vec<TrialResult> = results.to_vec();
+    let key = |r: &TrialResult| r.settle_1e6.unwrap_or(f64::INFINITY);
+    slowest.sort_by(|a, b| key(b).total_cmp(&key(a)).then(a.trial.cmp(&b.trial)));
+    slowest.truncate(SLOWEST);
+    McSummary {
+        trials_run: n,
+        failures,
+        failure_rate: if n == 0 {
+            0.0
+        } else {
+            failures as f64 / n as f64
+        },
+        failure_rate_upper_95: upper,
+        failure_rate_interval_95: interval,
+        failed_trials: (results.iter())
+            .filter(|r| r.outcome != Outcome::Converged)
+            .map(|r| r.trial)
+            .collect(),
+        slowest,
+        counts,
+        ..head
+    }
+}
+
+/// Median and maximum (with its trial) of the known values of `pick`.
+fn spread(results: &[TrialResult], pick: impl Fn(&TrialResult) -> Option<f64>) -> String {
+    let mut v: Vec<(f64, u64)> = results
+        .iter()
+        .filter_map(|r| Some((pick(r)?, r.trial)))
+        .collect();
+    if v.is_empty() {
+        return "never".into();
+    }
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (max, k) = v[v.len() - 1];
+    let never = results.len() - v.len();
+    format!(
+        "median {:.2} s, max {max:.2} s (trial {k}){}",
+        v[v.len() / 2].0,
+        if never > 0 {
+            format!(", never in {never}")
+        } else {
+            String::new()
+        }
+    )
+}
+
+/// The table printed at the end of `attsync mc`.
+#[must_use]
+pub fn table(s: &McSummary, results: &[TrialResult]) -> String {
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "{}: {} of {} trials ({} engine), seed {}, {} s each, tolerance {:e}",
+        s.scenario, s.trials_run, s.trials, s.engine, s.seed, s.duration, s.tolerance
+    );
+    let _ = writeln!(t, "{:<14} {:>8}", "outcome", "trials");
+    for o in Outcome::ALL {
+        let _ = writeln!(t, "{:<14} {:>8}", o.name(), s.counts.get(o));
+    }
+    let [lo, hi] = s.failure_rate_interval_95;
+    let _ = writeln!(
+        t,
+        "failure rate {}/{} = {:.4}; 95 % upper bound {:.4} (one-sided Clopper–Pearson), 95 % interval [{:.4}, {:.4}]",
+        s.failures, s.trials_run, s.failure_rate, s.failure_rate_upper_95, lo, hi
+    );
+    let _ = writeln!(t, "settle to 1e-3: {}", spread(results, |r| r.settle_1e3));
+    let _ = writeln!(t, "settle to 1e-6: {}", spread(results, |r| r.settle_1e6));
+    let worst = results
+        .iter()
+        .map(|r| r.final_max_att_err)
+        .fold(0.0, f64::max);
+    let _ = writeln!(t, "largest final att_err: {worst:.3e}");
+    if !s.failed_trials.is_empty() {
+        let list: Vec<String> = s
+            .failed_trials
+            .iter()
+            .take(20)
+            .map(u64::to_string)
+            .collect();
+        let more = if s.failed_trials.len() > 20 {
+            ", …"
+        } else {
+            ""
+        };
+        let _ = writeln!(t, "not converged: trials {}{more}", list.join(", "));
+    }
+    t
+}

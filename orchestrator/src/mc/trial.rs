@@ -1,0 +1,142 @@
+//! One trial: its draws applied to the scenario (as `--set` overrides,
+//! resolved like any run), the network run in memory (in-process, on one
+//! thread) or as processes, and its [`Trace`] classified.
+
+use super::dispersion::Dispersion;
+use super::draws::Draws;
+use super::outcome::{End, Trace, TrialResult, classify};
+use super::seed::{trial_rng, trial_seed};
+use crate::interrupt::Interrupt;
+use crate::options::StiffnessCheck;
+use crate::processes::{self, ProcessError, ProcessOptions};
+use crate::scenario::{self, Loaded, ScenarioError};
+use attitude::engine::InProcess;
+use std::path::{Path, PathBuf};
+
+/// The scenario every trial starts from: its text (read once), the
+/// user's overrides, and the resolved dispersion.
+#[derive(Debug, Clone)]
+pub struct Base {
+    /// The scenario file (messages; plug-ins run in its directory).
+    pub file: PathBuf,
+    /// Its text.
+    pub text: String,
+    /// `--set` overrides, applied before each trial's.
+    pub set: Vec<String>,
+    /// `--no-stiffness-check`.
+    pub check: StiffnessCheck,
+    /// What each trial draws.
+    pub dispersion: Dispersion,
+    /// The master seed.
+    pub seed: u64,
+    /// The base scenario (with `set`), loaded.
+    pub loaded: Loaded,
+}
+
+/// One trial, ready to run.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// Trial index.
+    pub trial: u64,
+    /// Its seed.
+    pub seed: u64,
+    /// Its draws.
+    pub draws: Draws,
+    /// The trial's overrides only (after the user's).
+    pub overrides: Vec<String>,
+    /// The scenario with every override, resolved.
+    pub loaded: Loaded,
+}
+
+impl Base {
+    /// Trial `k`: its seed, draws, overrides and scenario.
+    ///
+    /// # Errors
+    /// The scenario with the draws is invalid (it cannot be, unless the
+    /// scenario was already).
+    pub fn prepare(&self, k: u64) -> Result<Prepared, ScenarioError> {
+        let seed = trial_seed(self.seed, k);
+        let draws = self.dispersion.draw(&mut trial_rng(seed));
+        let overrides = self.dispersion.overrides(&draws);
+        let all: Vec<String> = self.set.iter().chain(&overrides).cloned().collect();
+        let loaded = scenario::load_str_with(&self.file, &self.text, &all, self.check)?;
+        Ok(Prepared {
+            trial: k,
+            seed,
+            draws,
+            overrides,
+            loaded,
+        })
+    }
+}
+
+/// How a trial's run ended, or that an interrupt stopped it.
+pub enum Ran {
+    /// It ran to an end (complete, diverged or failed).
+    Done(TrialResult),
+    /// The interrupt stopped it: no result.
+    Interrupted,
+}
+
+fn has_observer(p: &Prepared) -> bool {
+    let net = &p.loaded.resolved.network;
+    net.agents
+        .first()
+        .is_some_and(|a| a.model.scheme.has_observer())
+}
+
+/// Runs trial `p` in-process on the calling thread, keeping only its trace.
+#[must_use]
+pub fn run_in_process(p: &Prepared, tolerance: f64, interrupt: &Interrupt) -> Ran {
+    let net = &p.loaded.resolved.network;
+    let mut trace = Trace::new(net.dt, has_observer(p));
+    let mut engine = InProcess::new(net);
+    let mut stopped = false;
+    let diverged = engine.run(|snap| {
+        stopped = interrupt.is_set();
+        if !stopped {
+            trace.record(snap);
+        }
+        !stopped
+    });
+    if stopped {
+        return Ran::Interrupted;
+    }
+    let end = match diverged {
+        Some(d) => End::Diverged(d.message(net, p.loaded.resolved.stiffness.as_ref())),
+        None => End::Complete,
+    };
+    Ran::Done(classify(p.trial, p.seed, end, &trace, tolerance))
+}
+
+/// Runs trial `p` as processes (its own iceoryx2 namespace; node logs in
+/// `logs`), keeping only its trace.
+///
+/// # Errors
+/// The process engine could not start.
+pub fn run_processes(
+    p: &Prepared,
+    opts: &ProcessOptions,
+    logs: &Path,
+    tolerance: f64,
+    interrupt: &Interrupt,
+) -> Result<Ran, ProcessError> {
+    let net = &p.loaded.resolved.network;
+    let mut trace = Trace::new(net.dt, has_observer(p));
+    let mut opts = opts.clone();
+    opts.plugins = p.loaded.resolved.plugins.clone();
+    let outcome = processes::run(net, &opts, logs, interrupt.flag(), |snap| {
+        trace.record(snap);
+        true
+    })?;
+    if interrupt.is_set() {
+        return Ok(Ran::Interrupted);
+    }
+    let stiffness = p.loaded.resolved.stiffness.as_ref();
+    let end = match (outcome.diverged, outcome.failure) {
+        (Some(d), _) => End::Diverged(d.message(net, stiffness)),
+        (None, Some(why)) => End::Failed(why),
+        (None, None) => End::Complete,
+    };
+    Ok(Ran::Done(classify(p.trial, p.seed, end, &trace, tolerance)))
+}
