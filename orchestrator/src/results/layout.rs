@@ -8,6 +8,7 @@
 //!   summary.json                  the results
 //!   errors.csv                    error time series, one row per agent per sample
 //!   errors.svg                    plot of errors.csv
+//!   view.html                     the run in 3D in a browser (`attsync view`; not per sweep run)
 //!   states.bin                    full state trajectory (see `states`)
 //!   scenario.toml                 the scenario as run (copied)
 //!   logs/<node>.log               processes engine: leader.log, agent-<id>.log
@@ -32,6 +33,8 @@ pub const SUMMARY: &str = "summary.json";
 pub const ERRORS_CSV: &str = "errors.csv";
 /// `errors.svg`.
 pub const ERRORS_SVG: &str = "errors.svg";
+/// `view.html`: the run in 3D, one self-contained page (`crate::view`).
+pub const VIEW: &str = "view.html";
 /// `states.bin`.
 pub const STATES: &str = "states.bin";
 /// `scenario.toml`: the scenario as run.
@@ -50,9 +53,9 @@ pub const RUNS: &str = "runs";
 pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
-pub const OWNED: [&str; 11] = [
+pub const OWNED: [&str; 12] = [
     MARKER, SUMMARY, ERRORS_CSV, ERRORS_SVG, STATES, SCENARIO, LOGS, SWEEP_CSV, SWEEP_JSON,
-    SWEEP_SVG, RUNS,
+    SWEEP_SVG, RUNS, VIEW,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
@@ -167,6 +170,12 @@ impl RunLayout {
     #[must_use]
     pub fn states(&self) -> PathBuf {
         self.root.join(STATES)
+    }
+
+    /// `view.html`.
+    #[must_use]
+    pub fn view(&self) -> PathBuf {
+        self.root.join(VIEW)
     }
 
     /// `scenario.toml`.

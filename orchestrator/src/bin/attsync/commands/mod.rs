@@ -7,6 +7,7 @@ mod export;
 mod r#gen;
 mod run;
 mod sweep;
+mod view;
 
 use attsync::Error;
 use attsync::interrupt::Interrupt;
@@ -36,6 +37,9 @@ pub enum Command {
     Export(export::Export),
     /// Generate a scenario.
     Gen(r#gen::GenCmd),
+    /// Write a run directory's view.html again (the run in 3D, in any
+    /// browser, offline) from its scenario.toml, summary.json and states.bin.
+    View(view::View),
 }
 
 /// Runs `command`.
@@ -47,6 +51,7 @@ pub fn exec(command: Command) -> Result<(), Error> {
         Command::Conform(a) => conform::exec(a),
         Command::Export(a) => export::exec(a),
         Command::Gen(a) => r#gen::exec(a),
+        Command::View(a) => view::exec(a),
     }
 }
 
