@@ -294,9 +294,9 @@ def verdict(r):
     failed = [f"the page: {p}" for p in r["problems"]]
     if not r["probe_seen"]:
         failed.append("the probe request to http://127.0.0.1:9/ went unnoticed: the checks cannot see a request or a CSP error")
-    if r["drawn_pixels"] < r["scene_pixels"] // 200:
+    if r["drawn_pixels"] < r["scene_pixels"] // 50:
         failed.append(f"the 3D view at t = {r['times'][0]} is blank ({r['drawn_pixels']} of {r['scene_pixels']} pixels drawn)")
-    if r["changed_pixels"] < r["scene_pixels"] // 500:
+    if r["changed_pixels"] < r["scene_pixels"] // 200:
         failed.append(f"the 3D view at t = {r['times'][0]} and t = {r['times'][1]} is the same "
                       f"({r['changed_pixels']} of {r['scene_pixels']} pixels differ)")
     return failed
