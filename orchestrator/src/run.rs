@@ -287,7 +287,11 @@ fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Re
     let title = format!("{} ({})", summary.scenario, summary.engine);
     // Real-time runs measure every link's age of information; lockstep
     // links are ideal (or impaired by design, which summary.json lists).
-    let aoi = if summary.realtime.is_some() { &summary.links[..] } else { &[] };
+    let aoi = if summary.realtime.is_some() {
+        &summary.links[..]
+    } else {
+        &[]
+    };
     plot::draw(&svg, &title, series, aoi).map_err(|message| RunError::Plot {
         path: svg.clone(),
         message,

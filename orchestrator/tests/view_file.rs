@@ -40,7 +40,15 @@ fn ok(out: &Output) {
 }
 
 fn run(cwd: &Path, scenario: &str, out: &str, extra: &[&str]) {
-    let mut args = vec!["run", scenario, "--engine", "in-process", "--out", out, "--quiet"];
+    let mut args = vec![
+        "run",
+        scenario,
+        "--engine",
+        "in-process",
+        "--out",
+        out,
+        "--quiet",
+    ];
     args.extend(extra);
     ok(&attsync(cwd, &args));
 }
@@ -60,14 +68,30 @@ fn the_paper_run_writes_a_small_self_contained_view_that_attsync_view_remakes() 
     let file = tmp.path().join("tv/view.html");
     let html = fs::read_to_string(&file).expect("view.html");
     assert!(html.len() < 5_000_000, "view.html is {} bytes", html.len());
-    assert!(html.contains("default-src 'none'"), "no Content-Security-Policy");
-    for outside in ["http:", "https:", "//cdn", " src=", "<link rel=\"stylesheet\""] {
-        assert!(!html.contains(outside), "the page refers to something outside: {outside}");
+    assert!(
+        html.contains("default-src 'none'"),
+        "no Content-Security-Policy"
+    );
+    for outside in [
+        "http:",
+        "https:",
+        "//cdn",
+        " src=",
+        "<link rel=\"stylesheet\"",
+    ] {
+        assert!(
+            !html.contains(outside),
+            "the page refers to something outside: {outside}"
+        );
     }
     let d = data(&html);
     assert_eq!(d["scheme"], "observer-time-varying");
     assert_eq!(d["observer"], true);
-    assert_eq!(d["bodies"].as_array().map(Vec::len), Some(8), "leader + 7 agents");
+    assert_eq!(
+        d["bodies"].as_array().map(Vec::len),
+        Some(8),
+        "leader + 7 agents"
+    );
     let t = d["frames"]["t"].as_array().expect("times");
     assert_eq!(t.first().and_then(|v| v.as_f64()), Some(0.0));
     assert_eq!(t.last().and_then(|v| v.as_f64()), Some(40.0));
@@ -80,28 +104,51 @@ fn the_paper_run_writes_a_small_self_contained_view_that_attsync_view_remakes() 
     assert_eq!(leader_links, [1, 2]);
 
     let svg = fs::read_to_string(tmp.path().join("tv/errors.svg")).unwrap();
-    assert!(svg.contains(OBSERVER_CAPTION), "errors.svg lacks the observer's errors");
+    assert!(
+        svg.contains(OBSERVER_CAPTION),
+        "errors.svg lacks the observer's errors"
+    );
 
     fs::remove_file(&file).unwrap();
     let again = attsync(tmp.path(), &["view", "tv"]);
     ok(&again);
     assert!(String::from_utf8_lossy(&again.stdout).contains("view.html"));
-    assert_eq!(fs::read_to_string(&file).unwrap(), html, "attsync view wrote another page");
+    assert_eq!(
+        fs::read_to_string(&file).unwrap(),
+        html,
+        "attsync view wrote another page"
+    );
 }
 
 #[test]
 fn an_observerless_run_has_no_ghosts_and_no_view_with_no_view() {
     let tmp = tempfile::tempdir().unwrap();
-    run(tmp.path(), OBSERVERLESS, "ol", &["--set", "simulation.duration=1"]);
+    run(
+        tmp.path(),
+        OBSERVERLESS,
+        "ol",
+        &["--set", "simulation.duration=1"],
+    );
     let d = data(&fs::read_to_string(tmp.path().join("ol/view.html")).unwrap());
     assert_eq!(d["observer"], false);
     assert_eq!(d["frames"]["q_hat"], serde_json::json!([]));
     let svg = fs::read_to_string(tmp.path().join("ol/errors.svg")).unwrap();
-    assert!(!svg.contains(OBSERVER_CAPTION), "an observer panel without an observer");
+    assert!(
+        !svg.contains(OBSERVER_CAPTION),
+        "an observer panel without an observer"
+    );
 
-    run(tmp.path(), OBSERVERLESS, "none", &["--set", "simulation.duration=0.1", "--no-view"]);
+    run(
+        tmp.path(),
+        OBSERVERLESS,
+        "none",
+        &["--set", "simulation.duration=0.1", "--no-view"],
+    );
     assert!(tmp.path().join("none/summary.json").is_file());
-    assert!(!tmp.path().join("none/view.html").exists(), "--no-view wrote view.html");
+    assert!(
+        !tmp.path().join("none/view.html").exists(),
+        "--no-view wrote view.html"
+    );
 }
 
 #[test]

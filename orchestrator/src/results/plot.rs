@@ -26,7 +26,12 @@ pub const AOI: &str = "age of information per link (ms): mean and max";
 /// Draws the panels into `file` (SVG): the errors of `series` (and their
 /// observer errors where they have them), and the age of information of
 /// `aoi` (real-time runs' links; empty: no such panel).
-pub fn draw(file: &Path, title: &str, series: &[Series], aoi: &[LinkSummary]) -> Result<(), String> {
+pub fn draw(
+    file: &Path,
+    title: &str,
+    series: &[Series],
+    aoi: &[LinkSummary],
+) -> Result<(), String> {
     let observer = series.iter().any(|s| !s.obs_att.is_empty());
     let panels = 2 + if observer { 2 } else { 0 } + usize::from(!aoi.is_empty());
     let root = SVGBackend::new(file, (1000, PANEL_HEIGHT * panels as u32)).into_drawing_area();
@@ -35,7 +40,9 @@ pub fn draw(file: &Path, title: &str, series: &[Series], aoi: &[LinkSummary]) ->
         .titled(title, ("sans-serif", 22))
         .map_err(|e| e.to_string())?;
     let areas = root.split_evenly((panels, 1));
-    panel(&areas[0], "attitude error |R_i R_0^T|_I", series, |s| &s.att)?;
+    panel(&areas[0], "attitude error |R_i R_0^T|_I", series, |s| {
+        &s.att
+    })?;
     panel(
         &areas[1],
         "angular velocity error ||w_i - w_0|| (rad/s)",
@@ -53,10 +60,18 @@ pub fn draw(file: &Path, title: &str, series: &[Series], aoi: &[LinkSummary]) ->
 }
 
 /// The mean and largest age of information of each link, as bars (ms).
-fn aoi_bars<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, links: &[LinkSummary]) -> Result<(), String> {
+fn aoi_bars<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    links: &[LinkSummary],
+) -> Result<(), String> {
     let n = links.len();
     let ms = |x: f64| if x.is_finite() { x * 1e3 } else { 0.0 };
-    let top = links.iter().map(|l| ms(l.aoi_max)).fold(0.0, f64::max).max(1e-6) * 1.15;
+    let top = links
+        .iter()
+        .map(|l| ms(l.aoi_max))
+        .fold(0.0, f64::max)
+        .max(1e-6)
+        * 1.15;
     let mut chart = ChartBuilder::on(area)
         .margin(12)
         .x_label_area_size(40)
@@ -79,7 +94,10 @@ fn aoi_bars<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, links: &[LinkSumm
         .y_desc("ms")
         .draw()
         .map_err(|e| e.to_string())?;
-    let bars = [("mean age", 0.0, Palette99::pick(0)), ("max age", 0.4, Palette99::pick(1))];
+    let bars = [
+        ("mean age", 0.0, Palette99::pick(0)),
+        ("max age", 0.4, Palette99::pick(1)),
+    ];
     for (name, off, color) in bars {
         let color = color.to_rgba();
         let pick = |l: &LinkSummary| if off == 0.0 { l.aoi_mean } else { l.aoi_max };
@@ -210,6 +228,9 @@ mod tests {
         let links = [link(0, 1, 1e-3, 2e-3), link(1, 2, 5e-4, f64::NAN)];
         let text = svg(&series(false), &links);
         assert!(text.contains(AOI), "no panel");
-        assert!(text.contains("0→1") && text.contains("1→2"), "no label per link");
+        assert!(
+            text.contains("0→1") && text.contains("1→2"),
+            "no label per link"
+        );
     }
 }

@@ -72,9 +72,13 @@ pub fn view_data(net: &Network, run: RunInfo, frames: Frames) -> ViewData {
         edges,
         leader_links,
     } = graph::layout(net);
-    let boxes: Vec<[[f64; 3]; 3]> =
-        (net.agents.iter()).map(|a| shape::box_axes(&a.model.inertia.j)).collect();
-    let largest = boxes.iter().map(shape::largest_half_side).fold(0.0, f64::max);
+    let boxes: Vec<[[f64; 3]; 3]> = (net.agents.iter())
+        .map(|a| shape::box_axes(&a.model.inertia.j))
+        .collect();
+    let largest = boxes
+        .iter()
+        .map(shape::largest_half_side)
+        .fold(0.0, f64::max);
     let room = BODY_SIZE * graph::min_distance(&pos);
     let scale = room / largest.max(f64::MIN_POSITIVE);
     let h = 0.6 * room;
@@ -85,11 +89,17 @@ pub fn view_data(net: &Network, run: RunInfo, frames: Frames) -> ViewData {
         let linked = leader_links.contains(&(k + 1));
         bodies.push(body(a.model.id, pos[k + 1], axes, depth[k + 1], linked));
     }
-    let observer = net.agents.first().is_some_and(|a| a.model.scheme.has_observer());
+    let observer = net
+        .agents
+        .first()
+        .is_some_and(|a| a.model.scheme.has_observer());
     ViewData {
         format: FORMAT,
         run,
-        scheme: net.agents.first().map_or("observerless", |a| scheme_name(&a.model.scheme)),
+        scheme: net
+            .agents
+            .first()
+            .map_or("observerless", |a| scheme_name(&a.model.scheme)),
         observer,
         bodies,
         edges,

@@ -177,7 +177,10 @@ mod tests {
 
     #[test]
     fn attitudes_and_errors_are_stored_in_fixed_point() {
-        assert_eq!(quaternion(&Matrix3::identity()), [Some(10_000), Some(0), Some(0), Some(0)]);
+        assert_eq!(
+            quaternion(&Matrix3::identity()),
+            [Some(10_000), Some(0), Some(0), Some(0)]
+        );
         let half_turn_z = Matrix3::from_diagonal(&[-1.0, -1.0, 1.0].into());
         let q = quaternion(&half_turn_z);
         assert_eq!(q[..3], [Some(0); 3]);

@@ -124,7 +124,12 @@ fn leaf_counts(children: &[Vec<usize>]) -> Vec<usize> {
 /// `states.bin` may come from elsewhere): evenly on a ring beyond the rest.
 fn place_unreached(pos: &mut [[f64; 2]], depth: &mut [usize], parent: &[Option<usize>]) {
     let reached = |v: usize| v == 0 || parent[v].is_some();
-    let outer = (0..pos.len()).filter(|&v| reached(v)).map(|v| depth[v]).max().unwrap_or(0) + 1;
+    let outer = (0..pos.len())
+        .filter(|&v| reached(v))
+        .map(|v| depth[v])
+        .max()
+        .unwrap_or(0)
+        + 1;
     let lost: Vec<usize> = (0..pos.len()).filter(|&v| !reached(v)).collect();
     for (k, &v) in lost.iter().enumerate() {
         let a = TAU * k as f64 / lost.len() as f64;
@@ -162,7 +167,10 @@ mod tests {
         assert_eq!(l.depth, [0, 1, 1, 2, 4, 3, 3, 2]);
         for (v, p) in l.pos.iter().enumerate() {
             let r = p[0].hypot(p[1]);
-            assert!((r - f64::from(l.depth[v])).abs() < 1e-12, "node {v} at {p:?}");
+            assert!(
+                (r - f64::from(l.depth[v])).abs() < 1e-12,
+                "node {v} at {p:?}"
+            );
         }
         assert!(min_distance(&l.pos) > 0.5, "{:?}", l.pos);
     }

@@ -11,7 +11,7 @@
 //! - [`data`]: everything the page shows ([`ViewData`]), its JSON.
 //! - this module: the page assembled from `view.html`, `view.css` and
 //!   `view.js` (the page's own code, beside this file) with the data
-//!   ([`html`], [`write`]); a run directory's page made again from its
+//!   ([`html`], [`write()`]); a run directory's page made again from its
 //!   files ([`regenerate`]); [`ViewError`].
 //!
 //! The page reads the fragment `#t=12.5` (start time, s) and `&paused`, and
@@ -165,11 +165,16 @@ fn network_of(file: &Path) -> Result<Network, ViewError> {
         reason,
     };
     let text = std::fs::read_to_string(file).map_err(|e| err(e.to_string()))?;
-    let scenario: crate::scenario::Scenario = toml::from_str(&text).map_err(|e| err(e.to_string()))?;
+    let scenario: crate::scenario::Scenario =
+        toml::from_str(&text).map_err(|e| err(e.to_string()))?;
     let check = crate::options::StiffnessCheck::Warn;
     match crate::scenario::resolve::resolve_with(&scenario, check) {
         Ok(r) => Ok(r.network),
-        Err(issues) => Err(err(issues.iter().map(ToString::to_string).collect::<Vec<_>>().join("; "))),
+        Err(issues) => Err(err(issues
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join("; "))),
     }
 }
 

@@ -66,7 +66,10 @@ mod tests {
         let l = lengths(Matrix3::from_diagonal(&[0.1, 0.3, 0.2].into()));
         assert!((l[2] / l[1] - 2.0_f64.sqrt()).abs() < 1e-12, "{l:?}");
         assert!((l[0] / l[2] - 0.1).abs() < 1e-12, "{l:?}");
-        assert_eq!(largest_half_side(&box_axes(&Matrix3::identity())), 0.5_f64.sqrt());
+        assert_eq!(
+            largest_half_side(&box_axes(&Matrix3::identity())),
+            0.5_f64.sqrt()
+        );
     }
 
     #[test]
