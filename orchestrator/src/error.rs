@@ -60,6 +60,9 @@ pub enum Error {
     /// The signal handler could not be installed.
     #[error("installing the signal handler: {0}")]
     Signals(std::io::Error),
+    /// A run directory's `view.html` could not be made (`attsync view`).
+    #[error(transparent)]
+    View(#[from] crate::view::ViewError),
 }
 
 impl Error {

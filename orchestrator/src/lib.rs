@@ -14,6 +14,7 @@
 //! - [`options`]: range checks of command-line options, before anything starts.
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
 //! - [`error`]: [`enum@Error`], every way a command fails, and its exit code.
+//! - [`view`]: `view.html`, a run in 3D in the browser (one self-contained file).
 //!
 //! The binary (`src/bin/attsync/`) only parses the command line and calls
 //! these; one file per subcommand in `commands/`.
@@ -30,5 +31,6 @@ pub mod results;
 pub mod run;
 pub mod scenario;
 pub mod sweep;
+pub mod view;
 
 pub use error::Error;

@@ -10,6 +10,7 @@ use crate::results::layout::RunLayout;
 use crate::results::summary::{Diverged, LinkSummary, NodeSummary};
 use crate::results::{self, Recorder, Series, Summary, WriteError, plot, staging::Staging};
 use crate::scenario::Loaded;
+use crate::view;
 use attitude::engine::InProcess;
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -50,6 +51,9 @@ pub struct RunOptions {
     /// In-process engine: threads to step the agents on (≥ 1; a small
     /// network uses fewer, see [`InProcess::with_threads`]; [`default_threads`]).
     pub threads: usize,
+    /// Write `view.html` (`attsync run`, unless `--no-view`; not in a
+    /// sweep's runs: one page per value would be most of the sweep's size).
+    pub view: bool,
 }
 
 /// The default `--threads`: the number of cores (1 if unknown).
@@ -101,6 +105,9 @@ pub enum RunError {
     /// This machine cannot run the scenario with the chosen engine (nothing started).
     #[error(transparent)]
     Capacity(Box<CapacityError>),
+    /// Writing `view.html` failed.
+    #[error(transparent)]
+    View(#[from] crate::view::ViewError),
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -141,34 +148,46 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
     std::fs::write(layout.scenario(), text).map_err(io_at(&layout.scenario()))?;
     let started = Instant::now();
-    let (outcome, series, threads) = drive(loaded, opts, &layout, interrupt)?;
+    let (outcome, series, threads, frames) = drive(loaded, opts, &layout, interrupt)?;
     let wall_seconds = started.elapsed().as_secs_f64();
     let mut summary = summarise(loaded, opts, outcome, &series, wall_seconds);
     summary.threads = threads;
+    if let Some(frames) = frames {
+        let data = view::view_data(&loaded.resolved.network, view::run_info(&summary), frames);
+        view::write(&layout.view(), &data)?;
+    }
     write_results(&layout, &summary, &series)?;
     staging.commit().map_err(io_at(&opts.out))?;
     tracing::debug!(out = %opts.out.display(), complete = summary.complete, "run: committed");
     Ok(summary)
 }
 
-/// Runs the engine, recording every snapshot into `layout`; how it ended
-/// (its failure naming the signal if interrupted), the recorded series and
-/// the in-process engine's thread count.
+/// What [`drive`] recorded: how the run ended, the series, the in-process
+/// engine's thread count, and the frames of `view.html` (if asked for).
+type Driven = (Outcome, Vec<Series>, Option<usize>, Option<view::Frames>);
+
+/// Runs the engine, recording every snapshot into `layout` (and the view's
+/// frames); how it ended (its failure naming the signal if interrupted),
+/// the recorded series and the in-process engine's thread count.
 fn drive(
     loaded: &Loaded,
     opts: &RunOptions,
     layout: &RunLayout,
     interrupt: &Interrupt,
-) -> Result<(Outcome, Vec<Series>, Option<usize>), RunError> {
+) -> Result<Driven, RunError> {
     let net = &loaded.resolved.network;
     let dir = layout.root();
     let mut recorder = Recorder::new(dir, &loaded.name(), net).map_err(written)?;
+    let mut frames = opts.view.then(|| view::Collector::new(net));
     let bar = progress_bar(opts.progress, net.steps, net.dt);
     let mut write_error = None;
     let mut record = |snap: &attitude::engine::Snapshot<'_>| {
         if let Err(e) = recorder.record(snap) {
             write_error = Some(e);
             return false;
+        }
+        if let Some(f) = frames.as_mut() {
+            f.push(snap);
         }
         bar.set_position(snap.step);
         true
@@ -209,7 +228,8 @@ fn drive(
                 _ => f,
             }),
     };
-    Ok((Outcome { failure, ..outcome }, series, threads))
+    let frames = frames.map(view::Collector::finish);
+    Ok((Outcome { failure, ..outcome }, series, threads, frames))
 }
 
 /// `summary.json` of a run that ended as `outcome` with `series` recorded.
@@ -266,7 +286,14 @@ fn summarise(
 fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Result<(), RunError> {
     let svg = layout.errors_svg();
     let title = format!("{} ({})", summary.scenario, summary.engine);
-    plot::draw(&svg, &title, series).map_err(|message| RunError::Plot {
+    // Real-time runs measure every link's age of information; lockstep
+    // links are ideal (or impaired by design, which summary.json lists).
+    let aoi = if summary.realtime.is_some() {
+        &summary.links[..]
+    } else {
+        &[]
+    };
+    plot::draw(&svg, &title, series, aoi).map_err(|message| RunError::Plot {
         path: svg.clone(),
         message,
     })?;
@@ -407,6 +434,7 @@ mod tests {
             processes: ProcessOptions::default(),
             progress: false,
             threads: 1,
+            view: false,
         }
     }
 

@@ -590,6 +590,7 @@ mod tests {
                 processes: ProcessOptions::default(),
                 progress: false,
                 threads: 1,
+                view: false,
             },
             tolerance: 1e-3,
             find_margin: Some(Bisection {

@@ -6,7 +6,7 @@
 //! - exit codes: 0 on success, 2 for a scenario that cannot be loaded
 //!   (with `file: field: reason` on stderr), non-zero for other failures;
 //! - a results directory holds exactly `errors.csv`, `summary.json`,
-//!   `errors.svg` and `scenario.toml` (the effective scenario after `--set`),
+//!   `errors.svg`, `states.bin`, `view.html` and `scenario.toml` (the effective scenario after `--set`),
 //!   appears atomically (no `.partial-*` staging directory left behind), and
 //!   never replaces a directory that is not earlier attsync results;
 //! - runs and generated scenarios are deterministic (byte-identical).
@@ -25,13 +25,14 @@ const OBSERVERLESS: &str = concat!(
     "/../scenarios/paper/constant-observerless.toml"
 );
 const HEADER: &str = "t,agent,att_err,angvel_err,obs_att_err,obs_angvel_err";
-const RESULT_FILES: [&str; 6] = [
+const RESULT_FILES: [&str; 7] = [
     ".attsync-run",
     "errors.csv",
     "errors.svg",
     "scenario.toml",
     "states.bin",
     "summary.json",
+    "view.html",
 ];
 
 /// What a finished `attsync` process left.

@@ -8,6 +8,7 @@
 //!   summary.json                  the results
 //!   errors.csv                    error time series, one row per agent per sample
 //!   errors.svg                    plot of errors.csv
+//!   view.html                     the run in 3D in a browser (`attsync view`; not per sweep run)
 //!   states.bin                    full state trajectory (see `states`)
 //!   scenario.toml                 the scenario as run (copied)
 //!   logs/<node>.log               processes engine: leader.log, agent-<id>.log
@@ -36,6 +37,8 @@ pub const SUMMARY: &str = "summary.json";
 pub const ERRORS_CSV: &str = "errors.csv";
 /// `errors.svg`.
 pub const ERRORS_SVG: &str = "errors.svg";
+/// `view.html`: the run in 3D, one self-contained page (`crate::view`).
+pub const VIEW: &str = "view.html";
 /// `states.bin`.
 pub const STATES: &str = "states.bin";
 /// `scenario.toml`: the scenario as run.
@@ -62,7 +65,7 @@ pub const MC_SVG: &str = "mc.svg";
 pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
-pub const OWNED: [&str; 15] = [
+pub const OWNED: [&str; 16] = [
     MARKER,
     SUMMARY,
     ERRORS_CSV,
@@ -78,6 +81,7 @@ pub const OWNED: [&str; 15] = [
     INITIAL_CSV,
     MC_JSON,
     MC_SVG,
+    VIEW,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
@@ -192,6 +196,12 @@ impl RunLayout {
     #[must_use]
     pub fn states(&self) -> PathBuf {
         self.root.join(STATES)
+    }
+
+    /// `view.html`.
+    #[must_use]
+    pub fn view(&self) -> PathBuf {
+        self.root.join(VIEW)
     }
 
     /// `scenario.toml`.

@@ -1,33 +1,126 @@
 //! `errors.svg`: attitude and angular-velocity errors per agent against
-//! time, log scale, like the paper's figures (Section `simulation`).
+//! time, log scale, like the paper's figures (Section `simulation`); where
+//! the scheme has an observer, its errors `|R̂ᵢ R₀ᵀ|_I` and `‖ω̂ᵢ − ω₀‖` in
+//! two more panels; in real-time runs, the age of information of every
+//! link (mean and largest, as `summary.json` `links[]` has them: the runs
+//! record no time series of it).
 
 use super::Series;
+use super::summary::LinkSummary;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// Smallest value drawn on the log axes (exact zeros are clamped to it).
 const FLOOR: f64 = 1e-16;
+/// Height of one panel, px.
+const PANEL_HEIGHT: u32 = 450;
 
-/// Draws the two panels into `file` (SVG).
-pub fn draw(file: &Path, title: &str, series: &[Series]) -> Result<(), String> {
-    let root = SVGBackend::new(file, (1000, 900)).into_drawing_area();
+/// Caption of the observer's attitude-error panel.
+pub const OBSERVER_ATT: &str = "observer attitude error |Rhat_i R_0^T|_I";
+/// Caption of the observer's angular-velocity-error panel.
+pub const OBSERVER_ANGVEL: &str = "observer angular velocity error ||what_i - w_0|| (rad/s)";
+/// Caption of the age-of-information panel.
+pub const AOI: &str = "age of information per link (ms): mean and max";
+
+/// Draws the panels into `file` (SVG): the errors of `series` (and their
+/// observer errors where they have them), and the age of information of
+/// `aoi` (real-time runs' links; empty: no such panel).
+pub fn draw(
+    file: &Path,
+    title: &str,
+    series: &[Series],
+    aoi: &[LinkSummary],
+) -> Result<(), String> {
+    let observer = series.iter().any(|s| !s.obs_att.is_empty());
+    let panels = 2 + if observer { 2 } else { 0 } + usize::from(!aoi.is_empty());
+    let root = SVGBackend::new(file, (1000, PANEL_HEIGHT * panels as u32)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let root = root
         .titled(title, ("sans-serif", 22))
         .map_err(|e| e.to_string())?;
-    let (top, bottom) = root.split_vertically(440);
-    panel(&top, "attitude error |R_i R_0^T|_I", series, |s| &s.att)?;
+    let areas = root.split_evenly((panels, 1));
+    panel(&areas[0], "attitude error |R_i R_0^T|_I", series, |s| {
+        &s.att
+    })?;
     panel(
-        &bottom,
+        &areas[1],
         "angular velocity error ||w_i - w_0|| (rad/s)",
         series,
         |s| &s.angvel,
     )?;
+    if observer {
+        panel(&areas[2], OBSERVER_ATT, series, |s| &s.obs_att)?;
+        panel(&areas[3], OBSERVER_ANGVEL, series, |s| &s.obs_angvel)?;
+    }
+    if let Some(area) = areas.last().filter(|_| !aoi.is_empty()) {
+        aoi_bars(area, aoi)?;
+    }
     root.present().map_err(|e| e.to_string())
 }
 
+/// The mean and largest age of information of each link, as bars (ms).
+fn aoi_bars<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    links: &[LinkSummary],
+) -> Result<(), String> {
+    let n = links.len();
+    let ms = |x: f64| if x.is_finite() { x * 1e3 } else { 0.0 };
+    let top = links
+        .iter()
+        .map(|l| ms(l.aoi_max))
+        .fold(0.0, f64::max)
+        .max(1e-6)
+        * 1.15;
+    let mut chart = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .caption(AOI, ("sans-serif", 16))
+        .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top)
+        .map_err(|e| e.to_string())?;
+    let label = |x: &f64| {
+        let k = x.round();
+        match links.get(k as usize) {
+            Some(l) if (x - k).abs() < 1e-9 && k >= 0.0 => format!("{}→{}", l.from, l.to),
+            _ => String::new(),
+        }
+    };
+    chart
+        .configure_mesh()
+        .x_desc("link (from → to, 0 = leader)")
+        .x_labels(n.min(40) + 1)
+        .x_label_formatter(&label)
+        .y_desc("ms")
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let bars = [
+        ("mean age", 0.0, Palette99::pick(0)),
+        ("max age", 0.4, Palette99::pick(1)),
+    ];
+    for (name, off, color) in bars {
+        let color = color.to_rgba();
+        let pick = |l: &LinkSummary| if off == 0.0 { l.aoi_mean } else { l.aoi_max };
+        chart
+            .draw_series(links.iter().enumerate().map(|(k, l)| {
+                let x = k as f64 - 0.4 + off;
+                Rectangle::new([(x, 0.0), (x + 0.4, ms(pick(l)))], color.filled())
+            }))
+            .map_err(|e| e.to_string())?
+            .label(name)
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], color.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(|e| e.to_string())
+}
+
 fn panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
+    area: &DrawingArea<DB, Shift>,
     label: &str,
     series: &[Series],
     pick: impl Fn(&Series) -> &Vec<f64>,
@@ -82,4 +175,62 @@ fn panel<DB: DrawingBackend>(
         .position(SeriesLabelPosition::UpperRight)
         .draw()
         .map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn series(observer: bool) -> Vec<Series> {
+        let t = vec![0.0, 1.0, 2.0];
+        let e = vec![1.0, 1e-3, 0.0];
+        (1..=2)
+            .map(|id| Series {
+                id,
+                t: t.clone(),
+                att: e.clone(),
+                angvel: e.clone(),
+                obs_att: if observer { e.clone() } else { Vec::new() },
+                obs_angvel: if observer { e.clone() } else { Vec::new() },
+            })
+            .collect()
+    }
+
+    fn svg(series: &[Series], aoi: &[LinkSummary]) -> String {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let file = tmp.path().join("errors.svg");
+        draw(&file, "t", series, aoi).expect("drawn");
+        std::fs::read_to_string(file).expect("written")
+    }
+
+    #[test]
+    fn the_observer_errors_are_drawn_where_the_scheme_has_them() {
+        let with = svg(&series(true), &[]);
+        assert!(with.contains(OBSERVER_ATT) && with.contains(OBSERVER_ANGVEL));
+        assert!(!with.contains(AOI));
+        let without = svg(&series(false), &[]);
+        assert!(!without.contains(OBSERVER_ATT) && !without.contains(OBSERVER_ANGVEL));
+        assert!(without.contains("attitude error |R_i R_0^T|_I"));
+    }
+
+    #[test]
+    fn the_age_of_information_is_drawn_per_link() {
+        let link = |from, to, mean, max| LinkSummary {
+            from,
+            to,
+            sent: 10,
+            delivered: 10,
+            lost: 0,
+            aoi_mean: mean,
+            aoi_max: max,
+            rejected: 0,
+        };
+        let links = [link(0, 1, 1e-3, 2e-3), link(1, 2, 5e-4, f64::NAN)];
+        let text = svg(&series(false), &links);
+        assert!(text.contains(AOI), "no panel");
+        assert!(
+            text.contains("0→1") && text.contains("1→2"),
+            "no label per link"
+        );
+    }
 }

@@ -8,6 +8,7 @@ mod r#gen;
 mod mc;
 mod run;
 mod sweep;
+mod view;
 
 use attsync::Error;
 use attsync::interrupt::Interrupt;
@@ -41,6 +42,9 @@ pub enum Command {
     /// attitudes and random rates, each classified; the failure rate with
     /// its exact 95 % bound. `--trial K` reruns one trial alone.
     Mc(mc::Mc),
+    /// Write a run directory's view.html again (the run in 3D, in any
+    /// browser, offline) from its scenario.toml, summary.json and states.bin.
+    View(view::View),
 }
 
 /// Runs `command`.
@@ -53,6 +57,7 @@ pub fn exec(command: Command) -> Result<(), Error> {
         Command::Export(a) => export::exec(a),
         Command::Gen(a) => r#gen::exec(a),
         Command::Mc(a) => mc::exec(a, &interrupt()?),
+        Command::View(a) => view::exec(a),
     }
 }
 

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 
 /// `attsync run SCENARIO [--engine E] [--wait W] [--stage-timeout S]
 /// [--realtime [FACTOR]] [--threads N] [--out DIR] [--set K=V]… [--quiet]
-/// [--no-stiffness-check]`.
+/// [--no-stiffness-check] [--no-view]`.
 #[derive(Debug, clap::Args)]
 pub struct Run {
     #[command(flatten)]
@@ -38,6 +38,10 @@ pub struct Run {
     /// the scenario's loops (docs/stiffness.md): warn, and run anyway.
     #[arg(long)]
     pub no_stiffness_check: bool,
+    /// Do not write view.html (the run in 3D in a browser; `attsync view
+    /// DIR` writes it later from the results).
+    #[arg(long)]
+    pub no_view: bool,
 }
 
 /// Runs the scenario, prints its summary; an incomplete run is an error
@@ -49,6 +53,7 @@ pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
         processes: a.engine.process_options(a.realtime),
         progress: !a.quiet && std::io::stderr().is_terminal(),
         threads: a.threads.unwrap_or_else(run::default_threads),
+        view: !a.no_view,
     };
     opts.validate()?;
     let loaded = a

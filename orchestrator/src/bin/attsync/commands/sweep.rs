@@ -64,6 +64,7 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
             processes: a.engine.process_options(None),
             progress: false,
             threads,
+            view: false,
         },
         tolerance: a.tolerance,
         find_margin: a.find_margin.then_some(Bisection {
