@@ -9,6 +9,7 @@
 //!   errors.csv                    error time series, one row per agent per sample
 //!   errors.svg                    plot of errors.csv
 //!   states.bin                    full state trajectory (see `states`)
+//!   states.mcap                   `attsync export --mcap`'s default output (a recording)
 //!   scenario.toml                 the scenario as run (copied)
 //!   logs/<node>.log               processes engine: leader.log, agent-<id>.log
 //! results/<scenario>-sweep-<param>/   a sweep (`attsync sweep`, default --out)
@@ -34,6 +35,8 @@ pub const ERRORS_CSV: &str = "errors.csv";
 pub const ERRORS_SVG: &str = "errors.svg";
 /// `states.bin`.
 pub const STATES: &str = "states.bin";
+/// `states.mcap`: `attsync export DIR/states.bin --mcap`'s default output.
+pub const STATES_MCAP: &str = "states.mcap";
 /// `scenario.toml`: the scenario as run.
 pub const SCENARIO: &str = "scenario.toml";
 /// `logs/`: one log per node (processes engine).
@@ -50,9 +53,9 @@ pub const RUNS: &str = "runs";
 pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
-pub const OWNED: [&str; 11] = [
+pub const OWNED: [&str; 12] = [
     MARKER, SUMMARY, ERRORS_CSV, ERRORS_SVG, STATES, SCENARIO, LOGS, SWEEP_CSV, SWEEP_JSON,
-    SWEEP_SVG, RUNS,
+    SWEEP_SVG, RUNS, STATES_MCAP,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
