@@ -63,7 +63,12 @@ fn paper_run(name: &str, out: &Path) {
 }
 
 fn export(states: &Path, args: &[&str]) -> Output {
-    attsync().arg("export").arg(states).args(args).output().unwrap()
+    attsync()
+        .arg("export")
+        .arg(states)
+        .args(args)
+        .output()
+        .unwrap()
 }
 
 /// Runs `name`, exports both ways, reads the recording back in Python; returns
@@ -78,7 +83,10 @@ fn round_trip(name: &str) -> (String, String) {
     ok(&export(&states, &["--csv", "--out", csv.to_str().unwrap()]));
     let said = ok(&export(&states, &["--mcap"]));
     let recording = run.join("states.mcap");
-    assert!(recording.is_file(), "--mcap writes DIR/states.mcap by default");
+    assert!(
+        recording.is_file(),
+        "--mcap writes DIR/states.mcap by default"
+    );
     let checked = Command::new("python3")
         .arg(read_check())
         .args([&recording, &csv, &run.join("errors.csv")])
@@ -119,7 +127,10 @@ fn out_names_the_recording_and_csv_and_mcap_exclude_each_other() {
     paper_run("constant-observerless.toml", &run);
     let states = run.join("states.bin");
     let file = dir.path().join("elsewhere.mcap");
-    ok(&export(&states, &["--mcap", "--out", file.to_str().unwrap()]));
+    ok(&export(
+        &states,
+        &["--mcap", "--out", file.to_str().unwrap()],
+    ));
     let bytes = std::fs::read(&file).unwrap();
     assert_eq!(&bytes[..8], b"\x89MCAP0\r\n", "MCAP magic");
     assert_eq!(&bytes[bytes.len() - 8..], b"\x89MCAP0\r\n", "closed file");

@@ -110,7 +110,12 @@ fn frame_transforms_files() -> Vec<FileDescriptorProto> {
     ];
     let transforms = FieldDescriptorProto {
         label: Some(Label::Repeated as i32),
-        ..field("transforms", 1, Type::Message, Some(".foxglove.FrameTransform"))
+        ..field(
+            "transforms",
+            1,
+            Type::Message,
+            Some(".foxglove.FrameTransform"),
+        )
     };
     vec![
         timestamp_file(),
@@ -148,7 +153,12 @@ fn agent_errors_files() -> Vec<FileDescriptorProto> {
         field("timestamp", 1, Type::Message, Some(TIMESTAMP)),
         field("att_err", 2, Type::Double, None),
         field("angvel_err", 3, Type::Double, None),
-        field("observer", 4, Type::Message, Some(".attsync.ObserverErrors")),
+        field(
+            "observer",
+            4,
+            Type::Message,
+            Some(".attsync.ObserverErrors"),
+        ),
     ];
     vec![
         timestamp_file(),

@@ -115,13 +115,12 @@ fn write_to(records: states::Records, out: &Path) -> Result<McapSummary, McapExp
     for rec in records {
         let rec = rec.map_err(McapExportError::States)?;
         let sequence = summary.samples as u32;
-        summary.messages += write_sample(&mut w, &channels, sequence, &h, &rec).map_err(mcap_err)?;
+        summary.messages +=
+            write_sample(&mut w, &channels, sequence, &h, &rec).map_err(mcap_err)?;
         summary.samples += 1;
     }
     w.finish().map_err(mcap_err)?;
-    w.into_inner()
-        .flush()
-        .map_err(|e| mcap_err(e.into()))?;
+    w.into_inner().flush().map_err(|e| mcap_err(e.into()))?;
     Ok(summary)
 }
 
@@ -150,8 +149,11 @@ fn add_channels<W: Write + io::Seek>(w: &mut Writer<W>, h: &Header) -> mcap::Mca
         protobuf,
         &descriptor::frame_transforms(),
     )?;
-    let errors_schema =
-        w.add_schema(descriptor::AGENT_ERRORS, protobuf, &descriptor::agent_errors())?;
+    let errors_schema = w.add_schema(
+        descriptor::AGENT_ERRORS,
+        protobuf,
+        &descriptor::agent_errors(),
+    )?;
     let tf = w.add_channel(tf_schema, TF_TOPIC, protobuf, &none)?;
     let errors = h
         .agent_ids
@@ -180,7 +182,10 @@ fn write_sample<W: Write + io::Seek>(
         log_time: ns,
         publish_time: ns,
     };
-    w.write_to_known_channel(&header(channels.tf), &scene::transforms(h, rec).encode_to_vec())?;
+    w.write_to_known_channel(
+        &header(channels.tf),
+        &scene::transforms(h, rec).encode_to_vec(),
+    )?;
     let errors = scene::agent_errors(h, rec);
     for (&channel, e) in channels.errors.iter().zip(&errors) {
         w.write_to_known_channel(&header(channel), &e.encode_to_vec())?;

@@ -167,9 +167,14 @@ mod tests {
 
     #[test]
     fn the_quaternion_rotates_like_the_matrix() {
-        let r = attitude::so3::rot(0.8 * std::f64::consts::PI, &nalgebra::Vector3::new(1.0, 4.0, 2.0).normalize());
+        let r = attitude::so3::rot(
+            0.8 * std::f64::consts::PI,
+            &nalgebra::Vector3::new(1.0, 4.0, 2.0).normalize(),
+        );
         let q = quaternion(&msgs::to_rows(&r));
-        let back = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q.w, q.x, q.y, q.z));
+        let back = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            q.w, q.x, q.y, q.z,
+        ));
         assert!((back.to_rotation_matrix().matrix() - r).norm() < 1e-12);
     }
 }

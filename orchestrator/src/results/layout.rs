@@ -54,8 +54,18 @@ pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
 pub const OWNED: [&str; 12] = [
-    MARKER, SUMMARY, ERRORS_CSV, ERRORS_SVG, STATES, SCENARIO, LOGS, SWEEP_CSV, SWEEP_JSON,
-    SWEEP_SVG, RUNS, STATES_MCAP,
+    MARKER,
+    SUMMARY,
+    ERRORS_CSV,
+    ERRORS_SVG,
+    STATES,
+    SCENARIO,
+    LOGS,
+    SWEEP_CSV,
+    SWEEP_JSON,
+    SWEEP_SVG,
+    RUNS,
+    STATES_MCAP,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
