@@ -15,12 +15,16 @@
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
 //! - [`error`]: [`enum@Error`], every way a command fails, and its exit code.
 //! - [`view`]: `view.html`, a run in 3D in the browser (one self-contained file).
+//! - `export` (feature `mcap`, on by default): a run's `states.bin` as an MCAP
+//!   recording for Foxglove, Lichtblick and Rerun.
 //!
 //! The binary (`src/bin/attsync/`) only parses the command line and calls
 //! these; one file per subcommand in `commands/`.
 
 pub mod conform;
 pub mod error;
+#[cfg(feature = "mcap")]
+pub mod export;
 pub mod generate;
 pub mod interrupt;
 pub mod mc;

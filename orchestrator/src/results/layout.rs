@@ -10,6 +10,7 @@
 //!   errors.svg                    plot of errors.csv
 //!   view.html                     the run in 3D in a browser (`attsync view`; not per sweep run)
 //!   states.bin                    full state trajectory (see `states`)
+//!   states.mcap                   `attsync export --mcap`'s default output (a recording)
 //!   scenario.toml                 the scenario as run (copied)
 //!   logs/<node>.log               processes engine: leader.log, agent-<id>.log
 //! results/<scenario>-sweep-<param>/   a sweep (`attsync sweep`, default --out)
@@ -41,6 +42,8 @@ pub const ERRORS_SVG: &str = "errors.svg";
 pub const VIEW: &str = "view.html";
 /// `states.bin`.
 pub const STATES: &str = "states.bin";
+/// `states.mcap`: `attsync export DIR/states.bin --mcap`'s default output.
+pub const STATES_MCAP: &str = "states.mcap";
 /// `scenario.toml`: the scenario as run.
 pub const SCENARIO: &str = "scenario.toml";
 /// `logs/`: one log per node (processes engine).
@@ -65,7 +68,7 @@ pub const MC_SVG: &str = "mc.svg";
 pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
-pub const OWNED: [&str; 16] = [
+pub const OWNED: [&str; 17] = [
     MARKER,
     SUMMARY,
     ERRORS_CSV,
@@ -82,6 +85,7 @@ pub const OWNED: [&str; 16] = [
     MC_JSON,
     MC_SVG,
     VIEW,
+    STATES_MCAP,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.

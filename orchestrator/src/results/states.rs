@@ -20,7 +20,7 @@
 use attitude::engine::Snapshot;
 use attitude::network::{AgentState, Network};
 use attitude::reference::LeaderState;
-use msgs::to_rows;
+use msgs::{from_rows, to_rows};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Write};
@@ -167,8 +167,19 @@ impl StatesWriter {
     }
 }
 
-/// Reads a whole `states.bin`.
-pub fn read(file: &Path) -> Result<(Header, Vec<Record>), String> {
+/// An open `states.bin`: its header, then its records one at a time
+/// (the file's length is checked against whole records first).
+#[derive(Debug)]
+pub struct Records {
+    /// The header.
+    pub header: Header,
+    file: std::path::PathBuf,
+    r: BufReader<File>,
+    left: u64,
+}
+
+/// Opens `file`, reads and checks its header and that its records are whole.
+pub fn open(file: &Path) -> Result<Records, String> {
     let what = |e: &dyn std::fmt::Display| format!("{}: {e}", file.display());
     let len = std::fs::metadata(file).map_err(|e| what(&e))?.len();
     let mut r = BufReader::new(File::open(file).map_err(|e| what(&e))?);
@@ -193,11 +204,69 @@ pub fn read(file: &Path) -> Result<(Header, Vec<Record>), String> {
             "truncated: {body} bytes of records is not a multiple of the record size {record_len}"
         )));
     }
-    let mut records = Vec::with_capacity((body / record_len) as usize);
-    for _ in 0..body / record_len {
-        records.push(bincode::serde::decode_from_std_read(&mut r, config()).map_err(|e| what(&e))?);
+    Ok(Records {
+        header,
+        file: file.to_owned(),
+        r,
+        left: body / record_len,
+    })
+}
+
+impl Records {
+    /// How many records are left to read.
+    #[must_use]
+    pub fn remaining(&self) -> u64 {
+        self.left
     }
-    Ok((header, records))
+}
+
+impl Iterator for Records {
+    type Item = Result<Record, String>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.left == 0 {
+            return None;
+        }
+        self.left -= 1;
+        let rec = bincode::serde::decode_from_std_read(&mut self.r, config());
+        Some(rec.map_err(|e| format!("{}: {e}", self.file.display())))
+    }
+}
+
+/// Reads a whole `states.bin`.
+pub fn read(file: &Path) -> Result<(Header, Vec<Record>), String> {
+    let mut records = open(file)?;
+    let mut all = Vec::with_capacity(records.remaining() as usize);
+    for rec in &mut records {
+        all.push(rec?);
+    }
+    Ok((records.header, all))
+}
+
+impl LeaderRecord {
+    /// The leader's state, as the model holds it (matrices from rows).
+    #[must_use]
+    pub fn state(&self) -> LeaderState {
+        LeaderState {
+            r0: from_rows(&self.r0),
+            w0: self.w0.into(),
+            s0: self.s0.into(),
+        }
+    }
+}
+
+impl AgentRecord {
+    /// The agent's state, as the model holds it (matrices from rows).
+    #[must_use]
+    pub fn state(&self) -> AgentState {
+        AgentState {
+            r: from_rows(&self.r),
+            w: self.w.into(),
+            r_hat: from_rows(&self.r_hat),
+            w_hat: self.w_hat.into(),
+            s_hat: self.s_hat.into(),
+        }
+    }
 }
 
 /// Converts `states.bin` to CSV, long form: one row per node per record,
