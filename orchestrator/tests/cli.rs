@@ -6,7 +6,8 @@
 //! - exit codes: 0 on success, 2 for a scenario that cannot be loaded
 //!   (with `file: field: reason` on stderr), non-zero for other failures;
 //! - a results directory holds exactly `errors.csv`, `summary.json`,
-//!   `errors.svg` and `scenario.toml` (the effective scenario after `--set`),
+//!   `errors.svg`, `scenario.toml` (the effective scenario after `--set`) and
+//!   `manifest.json`,
 //!   appears atomically (no `.partial-*` staging directory left behind), and
 //!   never replaces a directory that is not earlier attsync results;
 //! - runs and generated scenarios are deterministic (byte-identical).
@@ -25,10 +26,11 @@ const OBSERVERLESS: &str = concat!(
     "/../scenarios/paper/constant-observerless.toml"
 );
 const HEADER: &str = "t,agent,att_err,angvel_err,obs_att_err,obs_angvel_err";
-const RESULT_FILES: [&str; 6] = [
+const RESULT_FILES: [&str; 7] = [
     ".attsync-run",
     "errors.csv",
     "errors.svg",
+    "manifest.json",
     "scenario.toml",
     "states.bin",
     "summary.json",

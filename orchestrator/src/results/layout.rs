@@ -11,6 +11,7 @@
 //!   states.bin                    full state trajectory (see `states`)
 //!   scenario.toml                 the scenario as run (copied)
 //!   logs/<node>.log               processes engine: leader.log, agent-<id>.log
+//!   manifest.json                 versions, seeds, platform, SHA-256 of every other file (written last)
 //! results/<scenario>-sweep-<param>/   a sweep (`attsync sweep`, default --out)
 //!   .attsync-run  summary.json    marker; summary.json has the content of sweep.json
 //!   sweep.csv  sweep.json  sweep.svg
@@ -46,13 +47,16 @@ pub const SWEEP_JSON: &str = "sweep.json";
 pub const SWEEP_SVG: &str = "sweep.svg";
 /// `runs/`: a sweep's runs.
 pub const RUNS: &str = "runs";
+/// `manifest.json`: what the run was and the SHA-256 of every other file
+/// (`results::manifest`; read by `attsync verify`).
+pub const MANIFEST: &str = "manifest.json";
 /// Default parent of results directories (relative to the working directory).
 pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
-pub const OWNED: [&str; 11] = [
+pub const OWNED: [&str; 12] = [
     MARKER, SUMMARY, ERRORS_CSV, ERRORS_SVG, STATES, SCENARIO, LOGS, SWEEP_CSV, SWEEP_JSON,
-    SWEEP_SVG, RUNS,
+    SWEEP_SVG, RUNS, MANIFEST,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
@@ -179,6 +183,12 @@ impl RunLayout {
     #[must_use]
     pub fn logs(&self) -> PathBuf {
         self.root.join(LOGS)
+    }
+
+    /// `manifest.json`.
+    #[must_use]
+    pub fn manifest(&self) -> PathBuf {
+        self.root.join(MANIFEST)
     }
 
     /// `logs/<node>.log` of node `id` (see [`node_name`]).

@@ -7,6 +7,7 @@ mod export;
 mod r#gen;
 mod run;
 mod sweep;
+mod verify;
 
 use attsync::Error;
 use attsync::interrupt::Interrupt;
@@ -36,6 +37,11 @@ pub enum Command {
     Export(export::Export),
     /// Generate a scenario.
     Gen(r#gen::GenCmd),
+    /// Check a run against its manifest.json and re-run its scenario: prints
+    /// "bit-identical" or the first difference (a changed file; the first
+    /// differing sample: time, node, field, both values). Exit code 0 only if
+    /// bit-identical, 1 if not, 2 if the run cannot be verified.
+    Verify(verify::Verify),
 }
 
 /// Runs `command`.
@@ -47,6 +53,7 @@ pub fn exec(command: Command) -> Result<(), Error> {
         Command::Conform(a) => conform::exec(a),
         Command::Export(a) => export::exec(a),
         Command::Gen(a) => r#gen::exec(a),
+        Command::Verify(a) => verify::exec(a, &interrupt()?),
     }
 }
 
