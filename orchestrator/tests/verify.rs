@@ -133,13 +133,29 @@ fn a_scenario_without_a_name_verifies_under_its_recorded_one() {
     let file = tmp.path().join("unnamed.toml");
     fs::write(&file, unnamed).unwrap();
     let out = tmp.path().join("out");
-    let args = ["run", file.to_str().unwrap(), "--engine", "in-process", "--quiet"];
-    let set = ["--set", "simulation.duration=0.2", "--out", out.to_str().unwrap()];
+    let args = [
+        "run",
+        file.to_str().unwrap(),
+        "--engine",
+        "in-process",
+        "--quiet",
+    ];
+    let set = [
+        "--set",
+        "simulation.duration=0.2",
+        "--out",
+        out.to_str().unwrap(),
+    ];
     attsync(tmp.path(), &[&args[..], &set[..]].concat()).assert_code(0);
     assert_eq!(json(&out.join("manifest.json"))["scenario"], "unnamed");
     let v = verify(tmp.path(), &out, &[]);
     v.assert_code(0);
-    assert_eq!(v.stdout.lines().last(), Some("bit-identical"), "{}", v.stdout);
+    assert_eq!(
+        v.stdout.lines().last(),
+        Some("bit-identical"),
+        "{}",
+        v.stdout
+    );
 }
 
 #[test]
