@@ -8,6 +8,9 @@
 //! | 1 | any other error (a node died, a rule failed, a file could not be written…) |
 //! | 3 | the run diverged: a state left the envelope (`summary.json` `diverged`) |
 //! | 128 + N | interrupted by signal N: 130 SIGINT, 143 SIGTERM, 129 SIGHUP |
+//!
+//! `attsync verify` ([`crate::verify`]): 0 bit-identical, 1 different (or the
+//! re-run failed), 2 a missing or bad manifest or a run that cannot be verified.
 
 use crate::options::OptionError;
 use crate::run::{RunEnd, RunError};
@@ -57,6 +60,12 @@ pub enum Error {
     /// A Monte Carlo produced no results (or was interrupted).
     #[error(transparent)]
     Mc(#[from] crate::mc::McError),
+    /// `attsync verify` could not verify a run ([`crate::verify::VerifyError::exit_code`]).
+    #[error(transparent)]
+    Verify(#[from] crate::verify::VerifyError),
+    /// `attsync verify`: the files or the re-run differ from the record (the report says where).
+    #[error("the run does not reproduce bit for bit (the report above says where)")]
+    NotIdentical,
     /// The signal handler could not be installed.
     #[error("installing the signal handler: {0}")]
     Signals(std::io::Error),
@@ -74,6 +83,7 @@ impl Error {
             Error::Run(e) => run_code(e),
             Error::RunEnd(RunEnd::Interrupted(signal)) => crate::interrupt::exit_code(*signal),
             Error::RunEnd(RunEnd::Diverged(_)) => DIVERGED,
+            Error::Verify(e) => e.exit_code(),
             Error::Sweep(e) => match e {
                 SweepError::Scenario(_) | SweepError::Options(_) => 2,
                 SweepError::Interrupted(signal) => crate::interrupt::exit_code(*signal),

@@ -11,6 +11,8 @@
 //! - [`generate`]: generated scenarios (random trees).
 //! - [`mc`]: the Monte Carlo over initial conditions (`attsync mc`).
 //! - [`conform`]: the conformance check of a plug-in agent program.
+//! - [`verify`]: `attsync verify`, a run's files against its `manifest.json`
+//!   and a re-run of its scenario against its `states.bin` and `errors.csv`.
 //! - [`options`]: range checks of command-line options, before anything starts.
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
 //! - [`error`]: [`enum@Error`], every way a command fails, and its exit code.
@@ -36,5 +38,6 @@ pub mod run;
 pub mod scenario;
 pub mod sweep;
 pub mod view;
+pub mod verify;
 
 pub use error::Error;

@@ -7,6 +7,7 @@ use crate::outcome::Outcome;
 use crate::processes::capacity::{self, CapacityError, Host, Need};
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::results::layout::RunLayout;
+use crate::results::manifest::{Manifest, Seeds};
 use crate::results::summary::{Diverged, LinkSummary, NodeSummary};
 use crate::results::{self, Recorder, Series, Summary, WriteError, plot, staging::Staging};
 use crate::scenario::Loaded;
@@ -14,7 +15,7 @@ use crate::view;
 use attitude::engine::InProcess;
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Instant, SystemTime};
 use thiserror::Error;
 
 /// Which engine runs the network.
@@ -135,6 +136,7 @@ fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 /// early, keeping the results so far marked incomplete (the reason names
 /// the signal, [`crate::interrupt::reason`]), when `interrupt` is raised.
 pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<Summary, RunError> {
+    let started_at = SystemTime::now();
     opts.validate()?;
     check_options(loaded, opts)?;
     check_capacity(loaded, opts)?;
@@ -146,7 +148,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     tracing::debug!(staging = %staging.path().display(), engine = opts.engine.name(), "run: staged");
     let layout = RunLayout::new(staging.path());
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
-    std::fs::write(layout.scenario(), text).map_err(io_at(&layout.scenario()))?;
+    std::fs::write(layout.scenario(), &text).map_err(io_at(&layout.scenario()))?;
     let started = Instant::now();
     let (outcome, series, threads, frames) = drive(loaded, opts, &layout, interrupt)?;
     let wall_seconds = started.elapsed().as_secs_f64();
@@ -157,6 +159,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
         view::write(&layout.view(), &data)?;
     }
     write_results(&layout, &summary, &series)?;
+    (manifest(loaded, opts, &summary, &text, started_at).write(&layout)).map_err(written)?;
     staging.commit().map_err(io_at(&opts.out))?;
     tracing::debug!(out = %opts.out.display(), complete = summary.complete, "run: committed");
     Ok(summary)
@@ -298,6 +301,37 @@ fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Re
         message,
     })?;
     results::write_summary(layout.root(), summary).map_err(written)
+}
+
+/// `manifest.json` of a run of `loaded` with `opts` that wrote `summary`
+/// (`scenario_text`: its `scenario.toml`; files listed when it is written).
+fn manifest(
+    loaded: &Loaded,
+    opts: &RunOptions,
+    summary: &Summary,
+    scenario_text: &str,
+    started: SystemTime,
+) -> Manifest {
+    use clap::ValueEnum;
+    let p = &opts.processes;
+    let processes = opts.engine == Engine::Processes;
+    let placement = p.placement.to_possible_value();
+    Manifest {
+        scenario: summary.scenario.clone(),
+        scenario_file: std::path::absolute(&loaded.file).unwrap_or_else(|_| loaded.file.clone()),
+        scenario_sha256: results::digest::sha256_hex(scenario_text.as_bytes()),
+        seeds: Seeds::of(loaded.scenario.network.seed, &loaded.resolved.network),
+        engine: opts.engine.name().into(),
+        wait: processes.then_some(p.wait),
+        placement: placement.filter(|_| processes).map(|v| v.get_name().into()),
+        threads: summary.threads,
+        stage_timeout: p.stage_timeout,
+        realtime: p.realtime,
+        complete: summary.complete,
+        incomplete_reason: summary.incomplete_reason.clone(),
+        diverged: summary.diverged.is_some(),
+        ..Manifest::now(started)
+    }
 }
 
 /// A results file that could not be written, as a [`RunError::Io`] naming it.

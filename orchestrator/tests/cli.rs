@@ -6,7 +6,8 @@
 //! - exit codes: 0 on success, 2 for a scenario that cannot be loaded
 //!   (with `file: field: reason` on stderr), non-zero for other failures;
 //! - a results directory holds exactly `errors.csv`, `summary.json`,
-//!   `errors.svg`, `states.bin`, `view.html` and `scenario.toml` (the effective scenario after `--set`),
+//!   `errors.svg`, `states.bin`, `view.html`, `scenario.toml` (the effective scenario after `--set`) and
+//!   `manifest.json`,
 //!   appears atomically (no `.partial-*` staging directory left behind), and
 //!   never replaces a directory that is not earlier attsync results;
 //! - runs and generated scenarios are deterministic (byte-identical).
@@ -29,6 +30,7 @@ const RESULT_FILES: [&str; 7] = [
     ".attsync-run",
     "errors.csv",
     "errors.svg",
+    "manifest.json",
     "scenario.toml",
     "states.bin",
     "summary.json",

@@ -13,6 +13,7 @@
 //!   states.mcap                   `attsync export --mcap`'s default output (a recording)
 //!   scenario.toml                 the scenario as run (copied)
 //!   logs/<node>.log               processes engine: leader.log, agent-<id>.log
+//!   manifest.json                 versions, seeds, platform, SHA-256 of every other file (written last)
 //! results/<scenario>-sweep-<param>/   a sweep (`attsync sweep`, default --out)
 //!   .attsync-run  summary.json    marker; summary.json has the content of sweep.json
 //!   sweep.csv  sweep.json  sweep.svg
@@ -64,11 +65,14 @@ pub const INITIAL_CSV: &str = "initial.csv";
 pub const MC_JSON: &str = "mc.json";
 /// `mc.svg`: a Monte Carlo's plot.
 pub const MC_SVG: &str = "mc.svg";
+/// `manifest.json`: what the run was and the SHA-256 of every other file
+/// (`results::manifest`; read by `attsync verify`).
+pub const MANIFEST: &str = "manifest.json";
 /// Default parent of results directories (relative to the working directory).
 pub const RESULTS: &str = "results";
 
 /// Every name attsync writes at the top of a run's or a sweep's directory.
-pub const OWNED: [&str; 17] = [
+pub const OWNED: [&str; 18] = [
     MARKER,
     SUMMARY,
     ERRORS_CSV,
@@ -86,6 +90,7 @@ pub const OWNED: [&str; 17] = [
     MC_SVG,
     VIEW,
     STATES_MCAP,
+    MANIFEST,
 ];
 
 /// A node's name in file names and messages: `leader` (id 0), `agent-<id>`.
@@ -218,6 +223,12 @@ impl RunLayout {
     #[must_use]
     pub fn logs(&self) -> PathBuf {
         self.root.join(LOGS)
+    }
+
+    /// `manifest.json`.
+    #[must_use]
+    pub fn manifest(&self) -> PathBuf {
+        self.root.join(MANIFEST)
     }
 
     /// `logs/<node>.log` of node `id` (see [`node_name`]).

@@ -14,9 +14,15 @@
 //! - [`staging`]: the atomic results directory (`.NAME.partial-PID`), replacing
 //!   only a directory marked as attsync's.
 //! - [`lock`]: the lock (`.NAME.lock`) serialising runs into one directory.
+//! - [`manifest`]: `manifest.json` (versions, seeds, settings, platform, the
+//!   SHA-256 of every other file), written last; [`digest`]: SHA-256 of bytes
+//!   and files; [`platform`]: the machine it records.
 
+pub mod digest;
 pub mod layout;
 pub mod lock;
+pub mod manifest;
+pub mod platform;
 pub mod plot;
 pub mod staging;
 pub mod states;

@@ -3,7 +3,8 @@
 //! The binary only parses the command line and calls the library, one file
 //! per subcommand in `commands/`; the exit code comes from the error
 //! ([`attsync::Error::exit_code`]): 0 success, 2 invalid scenario, `--set`
-//! or option, 1 any other error, 128 + N interrupted by signal N.
+//! or option, 1 any other error, 128 + N interrupted by signal N; `verify`:
+//! 0 bit-identical, 1 different, 2 a run that cannot be verified.
 
 mod commands;
 

@@ -9,6 +9,7 @@ mod mc;
 mod run;
 mod sweep;
 mod view;
+mod verify;
 
 use attsync::Error;
 use attsync::interrupt::Interrupt;
@@ -45,6 +46,11 @@ pub enum Command {
     /// Write a run directory's view.html again (the run in 3D, in any
     /// browser, offline) from its scenario.toml, summary.json and states.bin.
     View(view::View),
+    /// Check a run against its manifest.json and re-run its scenario: prints
+    /// "bit-identical" or the first difference (a changed file; the first
+    /// differing sample: time, node, field, both values). Exit code 0 only if
+    /// bit-identical, 1 if not, 2 if the run cannot be verified.
+    Verify(verify::Verify),
 }
 
 /// Runs `command`.
@@ -58,6 +64,7 @@ pub fn exec(command: Command) -> Result<(), Error> {
         Command::Gen(a) => r#gen::exec(a),
         Command::Mc(a) => mc::exec(a, &interrupt()?),
         Command::View(a) => view::exec(a),
+        Command::Verify(a) => verify::exec(a, &interrupt()?),
     }
 }
 
