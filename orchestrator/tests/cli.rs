@@ -26,7 +26,7 @@ const OBSERVERLESS: &str = concat!(
     "/../scenarios/paper/constant-observerless.toml"
 );
 const HEADER: &str = "t,agent,att_err,angvel_err,obs_att_err,obs_angvel_err";
-const RESULT_FILES: [&str; 7] = [
+const RESULT_FILES: [&str; 8] = [
     ".attsync-run",
     "errors.csv",
     "errors.svg",

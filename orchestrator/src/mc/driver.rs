@@ -299,6 +299,7 @@ pub fn trial_alone(
         processes: o.processes.clone(),
         progress: o.progress,
         threads: 1,
+        view: true,
     };
     let summary = crate::run::run(&prepared.loaded, &opts, interrupt)?;
     if let Some(signal) = interrupt.signal() {

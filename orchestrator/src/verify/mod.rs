@@ -190,6 +190,8 @@ fn options(
         processes,
         progress: opts.progress,
         threads: m.threads.unwrap_or_else(run::default_threads),
+        // The re-run is compared by states.bin and errors.csv only.
+        view: false,
     })
 }
 
