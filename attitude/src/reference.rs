@@ -108,7 +108,10 @@ impl Leader {
 
     /// Evaluates the current stage and moves on; returns `true` when a step completed.
     pub fn advance(&mut self) -> bool {
-        match self.step.push_derivative(&leader_field(&self.p, &self.stage_x)) {
+        match self
+            .step
+            .push_derivative(&leader_field(&self.p, &self.stage_x))
+        {
             Some(next) => {
                 self.state = LeaderState::from_lie(&next);
                 self.step = Rkmk4::new(next, self.dt);

@@ -203,6 +203,10 @@ mod tests {
         assert!(t.contains("| observerless | 10 | 200000 |"), "{t}");
         assert!(t.contains("(2) |") && t.contains(" – | – | – |"), "{t}");
         assert!(t.contains("| speed-up 1/2 |"), "{t}");
-        assert_eq!(t.lines().nth(1).map(|l| l.matches(":|").count()), Some(7), "{t}");
+        assert_eq!(
+            t.lines().nth(1).map(|l| l.matches(":|").count()),
+            Some(7),
+            "{t}"
+        );
     }
 }
