@@ -37,7 +37,7 @@ pub mod results;
 pub mod run;
 pub mod scenario;
 pub mod sweep;
-pub mod view;
 pub mod verify;
+pub mod view;
 
 pub use error::Error;

@@ -8,8 +8,8 @@ mod r#gen;
 mod mc;
 mod run;
 mod sweep;
-mod view;
 mod verify;
+mod view;
 
 use attsync::Error;
 use attsync::interrupt::Interrupt;
