@@ -338,3 +338,46 @@ fn run_accepts_a_scenario_with_a_monte_carlo_table() {
     ];
     attsync(tmp.path(), &args).assert_code(0);
 }
+
+/// The negative control (issue 13 item 4): over random initial conditions
+/// the paper's printed law stalls in every trial (final attitude errors near
+/// 1e-2: an independent integration of the printed law stalls at
+/// 6e-3–9e-3), while the corrected law converges from the same draws.
+#[test]
+fn the_printed_law_stalls_in_every_trial_and_the_corrected_one_converges() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = paper("timevarying");
+    let printed = mc(
+        tmp.path(),
+        &scenario,
+        4,
+        "printed",
+        &["--set", "scheme.law=\"as-printed\""],
+    );
+    printed.assert_code(0);
+    assert!(
+        printed.stderr.contains("negative control"),
+        "{}",
+        printed.stderr
+    );
+    let corrected = mc(tmp.path(), &scenario, 4, "corrected", &[]);
+    corrected.assert_code(0);
+    let (p, c) = (
+        trials(&tmp.path().join("printed")),
+        trials(&tmp.path().join("corrected")),
+    );
+    assert_eq!(p.len(), 4);
+    for (rp, rc) in p.iter().zip(&c) {
+        assert_eq!(rp[1], rc[1], "the same seeds: {rp:?} {rc:?}");
+        assert_eq!(rp[2], "not-converged", "{rp:?}");
+        let stall: f64 = rp[3].parse().unwrap();
+        assert!((1e-3..5e-2).contains(&stall), "{rp:?}");
+        assert_eq!(rc[2], "converged", "{rc:?}");
+    }
+    let m = json(&tmp.path().join("printed").join("mc.json"));
+    assert_eq!(m["failures"], 4);
+    assert_eq!(
+        json(&tmp.path().join("corrected").join("mc.json"))["failures"],
+        0
+    );
+}
