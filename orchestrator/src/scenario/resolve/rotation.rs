@@ -31,41 +31,61 @@ impl Ctx {
             return None;
         }
         if let Some(q) = r.quaternion {
-            if q.iter().any(|x| !x.is_finite()) || q.iter().all(|&x| x == 0.0) {
-                self.err(format!("{field}.quaternion"), "must be finite and non-zero");
-                return None;
-            }
-            // Scale by the largest component first so that tiny or huge
-            // inputs normalise without underflow or overflow.
-            let m = q.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-            let q = UnitQuaternion::from_quaternion(Quaternion::new(
-                q[0] / m,
-                q[1] / m,
-                q[2] / m,
-                q[3] / m,
-            ));
-            return Some(*q.to_rotation_matrix().matrix());
+            return self.rotation_quaternion(field, q);
         }
         if let Some(m) = r.matrix {
-            let m = rows(&m);
-            if m.iter().any(|x| !x.is_finite()) {
-                self.err(format!("{field}.matrix"), "must hold finite numbers");
-                return None;
-            }
-            if orthogonality_defect(&m) > 1e-9 || (m.determinant() - 1.0).abs() > 1e-9 {
-                self.err(
-                    format!("{field}.matrix"),
-                    format!(
-                        "is not a rotation: ‖RᵀR − I‖ = {:.3e}, det = {} (need orthogonal, det +1, to 1e-9)",
-                        orthogonality_defect(&m),
-                        m.determinant()
-                    ),
-                );
-                return None;
-            }
-            return Some(m);
+            return self.rotation_matrix(field, &m);
         }
-        let Some(axis) = r.axis else {
+        self.rotation_axis_angle(field, r.axis, &angles)
+    }
+
+    /// `quaternion = [w, x, y, z]`: finite, non-zero, normalised.
+    fn rotation_quaternion(&mut self, field: impl Display, q: [f64; 4]) -> Option<Matrix3<f64>> {
+        if q.iter().any(|x| !x.is_finite()) || q.iter().all(|&x| x == 0.0) {
+            self.err(format!("{field}.quaternion"), "must be finite and non-zero");
+            return None;
+        }
+        // Scale by the largest component first so that tiny or huge
+        // inputs normalise without underflow or overflow.
+        let m = q.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let q = UnitQuaternion::from_quaternion(Quaternion::new(
+            q[0] / m,
+            q[1] / m,
+            q[2] / m,
+            q[3] / m,
+        ));
+        Some(*q.to_rotation_matrix().matrix())
+    }
+
+    /// `matrix = [[..], [..], [..]]`: finite, a rotation to 1e-9.
+    fn rotation_matrix(&mut self, field: impl Display, m: &[[f64; 3]; 3]) -> Option<Matrix3<f64>> {
+        let m = rows(m);
+        if m.iter().any(|x| !x.is_finite()) {
+            self.err(format!("{field}.matrix"), "must hold finite numbers");
+            return None;
+        }
+        if orthogonality_defect(&m) > 1e-9 || (m.determinant() - 1.0).abs() > 1e-9 {
+            self.err(
+                format!("{field}.matrix"),
+                format!(
+                    "is not a rotation: ‖RᵀR − I‖ = {:.3e}, det = {} (need orthogonal, det +1, to 1e-9)",
+                    orthogonality_defect(&m),
+                    m.determinant()
+                ),
+            );
+            return None;
+        }
+        Some(m)
+    }
+
+    /// `axis` with exactly one of the `angles` (name, radians).
+    fn rotation_axis_angle(
+        &mut self,
+        field: impl Display + Copy,
+        axis: Option<[f64; 3]>,
+        angles: &[(&str, f64)],
+    ) -> Option<Matrix3<f64>> {
+        let Some(axis) = axis else {
             self.err(format!("{field}.axis"), "an angle needs an axis");
             return None;
         };
