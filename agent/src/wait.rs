@@ -12,6 +12,12 @@
 //!   of an idle machine (a vCPU descheduled by the hypervisor for a few ms)
 //!   thus costs 20 ms of blocking, not a second, while a lasting competitor
 //!   is probed only about once a second.
+//! - where the orchestrator places the run ([`Contention::Placement`]) it
+//!   moves the nodes off cores that competitors use, and the waiter ignores
+//!   slow yields: with more of the run's own processes than cores a yield
+//!   comes back late on an idle machine too (100 nodes on 2 cores: 10–40
+//!   per node per second), and blocking after each made such runs 2–5×
+//!   slower than plain yielding (BENCHMARKS.md, session 6).
 //!
 //! Blocking sleeps on the node's wake event in slices of [`BLOCK_SLICE`] and
 //! the caller re-polls its subscribers after every wake, timeout or not, so
@@ -19,7 +25,7 @@
 
 use iceoryx2::port::listener::Listener;
 use iceoryx2::service::Service;
-use msgs::config::WaitStrategy;
+use msgs::config::{Contention, WaitStrategy};
 use std::time::{Duration, Instant};
 
 /// Most yields of an adaptive waiter in one wait before it blocks.
@@ -50,6 +56,8 @@ pub struct Waiter {
     probing: bool,
     /// Times a yield was stolen (adaptive), for the node's report.
     stolen: u64,
+    /// Whether a stolen yield starts a hold ([`Contention::Waiter`]).
+    holds: bool,
     /// Longest single sleep on the wake event ([`BLOCK_SLICE`]).
     slice: Duration,
 }
@@ -66,8 +74,18 @@ impl Waiter {
             hold: HOLD_MIN,
             probing: false,
             stolen: 0,
+            holds: true,
             slice: BLOCK_SLICE,
         }
+    }
+
+    /// The same for a node whose competitors are handled by `contention`:
+    /// with [`Contention::Placement`] a stolen yield is counted but starts
+    /// no hold.
+    #[must_use]
+    pub fn with_contention(mut self, contention: Contention) -> Self {
+        self.holds = contention == Contention::Waiter;
+        self
     }
 
     /// The same with another longest sleep on the wake event (for the
@@ -155,6 +173,9 @@ impl Waiter {
         let probe = std::mem::take(&mut self.probing);
         if after.duration_since(before) > STOLEN {
             self.stolen += 1;
+            if !self.holds {
+                return;
+            }
             self.hold = if probe {
                 (self.hold * 2).min(HOLD_MAX)
             } else {
@@ -260,5 +281,19 @@ mod tests {
         assert_eq!(probe(&mut w, at, Duration::from_micros(10)), Duration::ZERO);
         w.after_yield(at, at + stolen);
         assert_eq!(w.contended_until, Some(at + stolen + HOLD_MIN));
+    }
+
+    #[test]
+    fn where_the_orchestrator_places_the_run_a_stolen_yield_is_counted_but_never_blocks() {
+        let t0 = Instant::now();
+        let mut w = adaptive(t0).with_contention(Contention::Placement);
+        let back = t0 + STOLEN * 2;
+        w.after_yield(t0, back);
+        assert_eq!(w.stolen(), 1);
+        assert_eq!(w.contended_until, None);
+        w.began = back;
+        assert_eq!(w.adaptive_step(back), Step::Yield);
+        // The window still ends a long wait in blocking.
+        assert_eq!(w.adaptive_step(back + YIELD_WINDOW * 2), Step::Block);
     }
 }

@@ -42,7 +42,7 @@ mod suite;
 
 use anyhow::{Context as _, bail};
 use clap::{Parser, Subcommand, ValueEnum};
-use msgs::config::WaitStrategy;
+use msgs::config::{Contention, WaitStrategy};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -153,6 +153,11 @@ enum Cmd {
         /// Longest single sleep on the wake event, ms (a lost wake-up costs this).
         #[arg(long, default_value_t = 1)]
         block_slice_ms: u64,
+        /// Adaptive: block for a while after a stolen yield, as a node that
+        /// nothing places does (default: not, as attsync's nodes under its
+        /// default placement).
+        #[arg(long)]
+        stolen_holds: bool,
     },
 }
 
@@ -226,6 +231,7 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             stage_timeout,
             barrier_timeout,
             block_slice_ms,
+            stolen_holds,
         } => {
             let node = ring::RingNode {
                 run,
@@ -240,6 +246,11 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
                 stage_timeout,
                 barrier_timeout,
                 block_slice: std::time::Duration::from_millis(block_slice_ms),
+                contention: if stolen_holds {
+                    Contention::Waiter
+                } else {
+                    Contention::Placement
+                },
             };
             println!("{}", node.run()?.line());
             Ok(())

@@ -39,7 +39,7 @@ use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::port::{BackpressureAction, BackpressureInfo};
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSub;
-use msgs::config::WaitStrategy;
+use msgs::config::{Contention, WaitStrategy};
 use msgs::{Limits, PROTOCOL_VERSION, StateMsg};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
@@ -71,6 +71,8 @@ pub struct RingNode {
     pub barrier_timeout: f64,
     /// Longest single sleep on the wake event (default the runtime's 1 ms).
     pub block_slice: Duration,
+    /// Who copes with competitors (an adaptive waiter's holds).
+    pub contention: Contention,
 }
 
 /// What a ring node measured.
@@ -380,7 +382,9 @@ impl RingNode {
     fn lockstep(&self, p: &Ports, inputs: &[u32]) -> Result<()> {
         let id = self.index;
         let stage_timeout = Duration::from_secs_f64(self.stage_timeout);
-        let mut waiter = Waiter::new(self.wait).with_block_slice(self.block_slice);
+        let mut waiter = Waiter::new(self.wait)
+            .with_block_slice(self.block_slice)
+            .with_contention(self.contention);
         let notify = waiter.receivers_may_block();
         for n in 0..self.steps {
             for s in 0..4u32 {
@@ -471,6 +475,7 @@ mod tests {
             stage_timeout: 1.0,
             barrier_timeout: 1.0,
             block_slice: Duration::from_millis(1),
+            contention: Contention::Placement,
         };
         assert_eq!(node.topology().unwrap(), (vec![7, 1], vec![7, 1]));
     }

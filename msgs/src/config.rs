@@ -24,9 +24,30 @@ pub enum WaitStrategy {
     Yield,
     /// Sleep on the node's wake event (1 ms slices; re-poll after every wake).
     Block,
-    /// Yield for a short while (≤ 200 polls, 2 ms), then block; block at once while
-    /// yields show that another program takes the core.
+    /// Yield for a short while (≤ 200 polls, 2 ms), then block; unless the
+    /// orchestrator places the run ([`Contention::Placement`]), block at once
+    /// while yields show that another program takes the core.
     Adaptive,
+}
+
+/// Who answers programs that compete with the run for its cores.
+///
+/// An adaptive waiter can see a competitor only by its yields coming back
+/// late; but when the run's own processes outnumber the cores (100 nodes on
+/// 2 cores) yields come back late on an idle machine too, and blocking then
+/// slows the whole lockstep several-fold. Where the orchestrator places the
+/// run (`--placement auto|pack`), it measures the foreign load itself and
+/// moves the run off busy cores, so the waiter need not guess.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Contention {
+    /// Nobody places the node: an adaptive waiter whose yield is stolen
+    /// blocks for a while (`agent::wait`).
+    #[default]
+    Waiter,
+    /// The orchestrator's placement copes: an adaptive waiter keeps
+    /// yielding (within its window) whatever its yields take.
+    Placement,
 }
 
 /// What the node is.
@@ -90,6 +111,10 @@ pub struct NodeConfig {
     /// absent: [`Envelope::default`].
     #[serde(default, skip_serializing_if = "Envelope::is_default")]
     pub guard: Envelope,
+    /// Who copes with competing programs ([`Contention`]); absent:
+    /// [`Contention::Waiter`].
+    #[serde(default)]
+    pub contention: Contention,
     /// The node's role and model.
     pub role: Role,
 }
@@ -223,6 +248,7 @@ mod tests {
             start_timeout: 30.0,
             realtime: None,
             guard: Envelope::default(),
+            contention: Contention::Waiter,
             role: Role::Agent {
                 model: Box::new(model),
                 initial: AgentState {

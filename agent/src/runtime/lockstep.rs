@@ -22,7 +22,7 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
     shutdown: &AtomicBool,
     orphan: &Orphan,
 ) -> Result<Pacing, NodeError> {
-    let mut waiter = Waiter::new(cfg.wait);
+    let mut waiter = Waiter::new(cfg.wait).with_contention(cfg.contention);
     io.report(stepper.sample(0))?;
     for slot in Schedule::new(cfg.coupling, cfg.steps).slots() {
         if slot.starts_step() {

@@ -260,6 +260,7 @@ mod tests {
             start_timeout: 30.0,
             realtime: None,
             guard: Default::default(),
+            contention: msgs::config::Contention::Waiter,
             role: Role::Agent {
                 model: Box::new(model),
                 initial,

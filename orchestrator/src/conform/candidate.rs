@@ -28,6 +28,8 @@ pub(super) fn candidate_config(
     let popts = ProcessOptions {
         stage_timeout: opts.stage_timeout,
         start_timeout: opts.start_timeout,
+        // Nothing places a candidate: its waiter copes with competitors.
+        placement: crate::processes::placement::Placement::Spread,
         ..ProcessOptions::default()
     };
     node_configs(net, run, root, &popts).swap_remove(index + 1)

@@ -60,6 +60,7 @@ pub fn node_configs(
         .filter(|a| a.model.leader_gain.is_some())
         .map(|a| a.model.id)
         .collect();
+    let contention = super::placement::contention(opts.placement);
     let base = |id: u32, inputs: Vec<u32>, outputs: Vec<u32>, role: Role| NodeConfig {
         protocol_version: PROTOCOL_VERSION,
         run: run.to_string(),
@@ -77,6 +78,7 @@ pub fn node_configs(
         start_timeout: opts.start_timeout,
         realtime: opts.realtime,
         guard: net.guard,
+        contention,
         role,
     };
     let mut out = vec![base(

@@ -16,6 +16,7 @@
 //! The [`Placer`] thread samples `/proc/stat` and each node's
 //! `/proc/<pid>/stat` every [`WINDOW`]; [`decide`] is the policy, pure.
 
+use msgs::config::Contention;
 use nix::sched::{CpuSet, sched_getaffinity, sched_setaffinity};
 use nix::unistd::Pid;
 use std::sync::Arc;
@@ -123,6 +124,25 @@ fn cores_of(set: &CpuSet) -> Vec<usize> {
         .collect()
 }
 
+/// Whether a [`Placer`] for `placement` watches the load with `cores`
+/// cores to place on (not for `Spread`, and not on a single core).
+fn watches(placement: Placement, cores: usize) -> bool {
+    cores > 1 && placement != Placement::Spread
+}
+
+/// Who copes with competing programs when the run is placed by
+/// `placement` on this machine: the placement where it watches the load,
+/// else the nodes' waiters. Goes into every node's configuration.
+#[must_use]
+pub fn contention(placement: Placement) -> Contention {
+    let cores = sched_getaffinity(Pid::from_raw(0)).map_or(1, |set| cores_of(&set).len());
+    if watches(placement, cores) {
+        Contention::Placement
+    } else {
+        Contention::Waiter
+    }
+}
+
 /// Samples the load and moves the run's nodes; stops when dropped.
 #[derive(Debug)]
 pub struct Placer {
@@ -140,7 +160,7 @@ impl Placer {
         };
         let cores = cores_of(&allowed);
         let flag = Arc::clone(&stop);
-        let thread = (cores.len() > 1 && placement != Placement::Spread).then(|| {
+        let thread = watches(placement, cores.len()).then(|| {
             std::thread::spawn(move || {
                 super::load::watch(placement, &pids, &allowed, &cores, &flag)
             })
@@ -216,5 +236,13 @@ mod tests {
         assert_eq!(decide(packed, &window(0.3)), packed);
         let s = decide(decide(packed, &window(0.1)), &window(0.05));
         assert_eq!(s.placed, Placed::Spread);
+    }
+
+    #[test]
+    fn only_a_watching_placement_takes_contention_off_the_waiters() {
+        assert!(watches(Placement::Auto, 2));
+        assert!(watches(Placement::Pack, 2));
+        assert!(!watches(Placement::Spread, 2));
+        assert!(!watches(Placement::Auto, 1));
     }
 }
