@@ -11,11 +11,22 @@ use std::process::{Command, Stdio};
 /// Where shared-memory segments live.
 pub(crate) const SHM_DIR: &str = "/dev/shm";
 
-/// Parent of every run's iceoryx2 root directory: `$TMPDIR/attsync-iox2`
-/// (the same `std::env::temp_dir()` the child sees).
+/// Parent of every run's iceoryx2 root directory, as the orchestrator
+/// chooses it (`attsync::processes::namespace::base_dir`): `$TMPDIR/attsync-iox2`
+/// where `TMPDIR` is set (as the child sees it), else `/dev/shm/attsync-iox2`
+/// if that exists, else `/tmp/attsync-iox2`. (A `TMPDIR` too long for socket
+/// paths is the business of the test that sets it.)
 #[must_use]
 pub fn iox_base() -> PathBuf {
-    std::env::temp_dir().join("attsync-iox2")
+    if let Some(tmp) = std::env::var_os("TMPDIR").filter(|t| !t.is_empty()) {
+        return PathBuf::from(tmp).join("attsync-iox2");
+    }
+    let shm = Path::new(SHM_DIR).join("attsync-iox2");
+    if shm.is_dir() {
+        shm
+    } else {
+        PathBuf::from("/tmp/attsync-iox2")
+    }
 }
 
 /// Every run directory under [`iox_base`] and every `as*` file in /dev/shm.

@@ -226,7 +226,7 @@ fn check_space(host: &Host, need: &Need) -> Result<(), Shortfall> {
             "free space in /dev/shm (or enlarge it: `mount -o remount,size=… /dev/shm`)",
         ),
         (
-            "the free space of the namespace root ($TMPDIR/attsync-iox2)",
+            "the free space of the namespace root (/dev/shm/attsync-iox2 or $TMPDIR/attsync-iox2)",
             root,
             host.root_free,
             "free space there, or set TMPDIR to a larger file system",

@@ -1,5 +1,5 @@
 //! A run's iceoryx2 namespace on this machine: a root directory
-//! `<tmp>/attsync-iox2/<run>/` and the file prefix `as<run>_` (see
+//! `<base>/attsync-iox2/<run>/` (`<base>`: `$TMPDIR`, else `/dev/shm`; [`base_dir`]) and the file prefix `as<run>_` (see
 //! [`msgs::namespace`]). Removing both removes everything the run created;
 //! namespaces whose owner process is gone are removed on start.
 
@@ -25,12 +25,20 @@ const BASE_NAME: &str = "attsync-iox2";
 /// and a run id takes up to 15.
 pub const MAX_BASE_LEN: usize = 40;
 
-/// Parent directory of every run's namespace: `$TMPDIR/attsync-iox2`, or
-/// `/tmp/attsync-iox2` if that is longer than [`MAX_BASE_LEN`] (said with
-/// `ATTSYNC_DEBUG`) and `/tmp` is writable.
+/// Parent directory of every run's namespace: `$TMPDIR/attsync-iox2` where
+/// `TMPDIR` is set, else `/dev/shm/attsync-iox2`, else `/tmp/attsync-iox2`.
+/// tmpfs first because iceoryx2 fsyncs each service's static configuration
+/// (3 fsyncs per service, 5 + degree services per node): on a disk busy with
+/// other work each fsync waits for the device, and start-up took 65–86 ms
+/// per node against 14–17 on tmpfs (BENCHMARKS.md, "Start-up and
+/// capacity"). A `$TMPDIR` base longer than [`MAX_BASE_LEN`] is replaced by
+/// `/tmp/attsync-iox2` if `/tmp` is writable (said with `ATTSYNC_DEBUG`).
 #[must_use]
 pub fn base_dir() -> PathBuf {
-    let base = std::env::temp_dir().join(BASE_NAME);
+    let Some(tmp) = std::env::var_os("TMPDIR").filter(|t| !t.is_empty()) else {
+        return default_base();
+    };
+    let base = PathBuf::from(tmp).join(BASE_NAME);
     if base.as_os_str().len() <= MAX_BASE_LEN {
         return base;
     }
@@ -44,6 +52,17 @@ pub fn base_dir() -> PathBuf {
         return short;
     }
     base
+}
+
+/// The base without `TMPDIR`: on tmpfs (`/dev/shm`) where it can be
+/// created, else in `/tmp`.
+fn default_base() -> PathBuf {
+    let shm = Path::new("/dev/shm").join(BASE_NAME);
+    if fs::create_dir_all(&shm).is_ok() {
+        shm
+    } else {
+        Path::new("/tmp").join(BASE_NAME)
+    }
 }
 
 /// An error if `base` (from [`base_dir`]) is too long for socket paths.

@@ -25,7 +25,7 @@
 //! .<name>.partial-<pid>/          staging directory beside `<name>` while it is written
 //! .<name>.partial-<pid>.old/      the replaced results, while the new ones move in
 //! .<name>.lock                    held (flock) by the run writing `<name>`; removed after
-//! <tmp>/attsync-iox2/<run>/node-<id>.json   a node's configuration (processes engine)
+//! <base>/attsync-iox2/<run>/node-<id>.json   a node's configuration (processes engine)
 //! ```
 
 use std::path::{Path, PathBuf};
