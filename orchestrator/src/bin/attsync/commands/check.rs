@@ -5,7 +5,6 @@ use super::ScenarioArgs;
 use attsync::Error;
 use attsync::options::StiffnessCheck;
 use attsync::processes::{self, ProcessOptions};
-use std::path::Path;
 
 /// `attsync check SCENARIO [--set K=V]… [--node-config ID] [--no-stiffness-check]`.
 #[derive(Debug, clap::Args)]
@@ -36,9 +35,9 @@ pub fn exec(a: Check) -> Result<(), Error> {
     };
     let net = &loaded.resolved.network;
     let index = attsync::options::node_index(net, id, "--node-config", true, &loaded.file)?;
-    let root = Path::new("/tmp/attsync-iox2/RUN");
+    let root = processes::namespace::base_dir().join("RUN");
     let cfg =
-        processes::node_configs(net, "RUN", root, &ProcessOptions::default()).swap_remove(index);
+        processes::node_configs(net, "RUN", &root, &ProcessOptions::default()).swap_remove(index);
     println!(
         "{}",
         serde_json::to_string_pretty(&cfg).expect("a config serialises")
