@@ -9,6 +9,10 @@
 //! problems still gets all of them at once, with their lines; and the two
 //! passes agree on every valid file (same `Scenario`, same `Network`). The
 //! header of `gen tree`'s file is the whole command that reproduces it.
+//!
+//! The text is read by a streaming reader (`toml_parser`'s events into a
+//! compact tree, no token or event vector): it reads what toml reads, the
+//! same `Scenario` and the same `scenario.toml` bytes, with `--set` too.
 
 use attsync::generate::{TreeParams, tree};
 use attsync::scenario::deserialize::{Kind, collect, deserialize};
@@ -342,4 +346,93 @@ fn the_header_of_a_generated_file_is_the_command_that_reproduces_it() {
     attsync_ok(tmp.path(), &again);
     let b = std::fs::read_to_string(tmp.path().join("b.toml")).unwrap();
     assert_eq!(a, b, "the header's command writes the same file");
+}
+
+/// The scenario files, each with its path.
+fn scenario_files() -> Vec<(String, String)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios");
+    let mut out = Vec::new();
+    for dir in [root.clone(), root.join("paper"), root.join("plugin")] {
+        for f in std::fs::read_dir(&dir).unwrap() {
+            let f = f.unwrap().path();
+            if f.extension().is_some_and(|e| e == "toml") {
+                out.push((
+                    f.display().to_string(),
+                    std::fs::read_to_string(&f).unwrap(),
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// `text` read by toml into a `Table`, with `sets` applied: the document
+/// as it was before the streaming reader.
+fn toml_document(text: &str, sets: &[String]) -> Table {
+    let mut doc: Table = text.parse().expect("TOML");
+    for s in sets {
+        attsync::scenario::overrides::apply(&mut doc, s).expect("the override applies");
+    }
+    doc
+}
+
+/// The streaming reader (`load_str`) against toml's `Table` with the same
+/// overrides: the same `scenario.toml` bytes and the same `Scenario`.
+#[track_caller]
+fn reads_as_toml(what: &str, text: &str, sets: &[String]) -> bool {
+    let doc = toml_document(text, sets);
+    let written = toml::to_string(&doc).expect("serialises");
+    match load_str(Path::new("s.toml"), text, sets) {
+        Ok(loaded) => {
+            let ours = toml::to_string(&loaded.document).expect("serialises");
+            assert_eq!(ours, written, "{what}: scenario.toml");
+            let slow = collect(&doc).unwrap_or_else(|e| panic!("{what}: {e:?}"));
+            assert_eq!(
+                format!("{:?}", loaded.scenario),
+                format!("{slow:?}"),
+                "{what}: Scenario"
+            );
+            true
+        }
+        // Valid TOML and schema; a model assumption fails (resolve).
+        Err(ScenarioError::Invalid { .. }) => false,
+        Err(e) => panic!("{what}: {e}"),
+    }
+}
+
+#[test]
+fn the_streaming_reader_reads_what_toml_reads() {
+    let mut read = 0;
+    let files = scenario_files();
+    for (name, text) in &files {
+        read += usize::from(reads_as_toml(name, text, &[]));
+    }
+    assert!(read >= 4, "{read} of {} files read", files.len());
+    for scheme in [
+        SchemeKind::ObserverTimeVarying,
+        SchemeKind::ObserverConstant,
+        SchemeKind::Observerless,
+    ] {
+        let text = generated(3_000, 4, scheme);
+        assert!(reads_as_toml(&format!("tree {scheme:?}"), &text, &[]));
+    }
+    let sets: Vec<String> = [
+        "simulation.duration=0.5",
+        "agent[2].omega=[0.25, -1, 3e-2]",
+        "agent[7].attitude.angle_deg=12.5",
+        "name=\"renamed\"",
+        "guard.omega=500.0",
+        "network.seed=7",
+    ]
+    .map(String::from)
+    .to_vec();
+    let text = generated(1_000, 2, SchemeKind::ObserverTimeVarying);
+    assert!(reads_as_toml("tree with --set", &text, &sets));
+    let paper = std::fs::read_to_string(PAPER).unwrap();
+    // A table defined after one of its sub-tables (TOML allows it): read,
+    // and its unknown key reported.
+    let late = format!("{paper}\n[guard.extra]\n[guard]\nomega = 100.0\n");
+    assert!(late.parse::<Table>().is_ok(), "TOML");
+    let e = load_str(Path::new("s.toml"), &late, &[]).expect_err("guard.extra is unknown");
+    assert!(e.to_string().contains("guard.extra"), "{e}");
 }

@@ -1,8 +1,8 @@
-//! A serde `Deserializer` over a *borrowed* TOML value, for the fast path
-//! of [`super::deserialize`]: toml's own deserializer of a `toml::Value`
-//! (0.9, `value.rs`) takes the value by value, so reading a document that
-//! must be kept (`Loaded::document`) would first copy the whole table —
-//! hundreds of MiB at 10⁵ agents.
+//! A serde `Deserializer` over a *borrowed* tree (`stream`'s), for
+//! the fast path of [`super::deserialize`]: toml's own deserializer of a
+//! `toml::Value` (0.9, `value.rs`) takes the value by value, so reading a
+//! document that must be kept would first copy the whole table — hundreds
+//! of MiB at 10⁵ agents.
 //!
 //! It mirrors toml's semantics (integers as `i64`, a present value as
 //! `Some`, arrays and tables read to their end, enums from strings) with one
@@ -11,20 +11,21 @@
 //! result; whatever it refuses goes to the collecting pass, whose messages
 //! come from toml's own deserializer.
 
+use super::stream::{Node, Table};
 use serde::de::value::BorrowedStrDeserializer;
 use serde::de::{self, DeserializeSeed, IntoDeserializer, MapAccess, SeqAccess, Visitor};
+use std::borrow::Cow;
 use toml::de::Error;
-use toml::{Table, Value};
 
 /// `v`, to be deserialised in place.
 #[derive(Clone, Copy)]
-pub(super) struct ValueRef<'a>(pub(super) &'a Value);
+pub(super) struct ValueRef<'a, 'i>(pub(super) &'a Node<'i>);
 
 /// A whole document, to be deserialised in place.
 #[derive(Clone, Copy)]
-pub(super) struct TableRef<'a>(pub(super) &'a Table);
+pub(super) struct TableRef<'a, 'i>(pub(super) &'a Table<'i>);
 
-impl<'de> de::Deserializer<'de> for TableRef<'de> {
+impl<'de> de::Deserializer<'de> for TableRef<'de, '_> {
     type Error = Error;
 
     fn deserialize_any<V: Visitor<'de>>(self, visitor: V) -> Result<V::Value, Error> {
@@ -38,17 +39,17 @@ impl<'de> de::Deserializer<'de> for TableRef<'de> {
     }
 }
 
-impl<'de> de::Deserializer<'de> for ValueRef<'de> {
+impl<'de> de::Deserializer<'de> for ValueRef<'de, '_> {
     type Error = Error;
 
     fn deserialize_any<V: Visitor<'de>>(self, visitor: V) -> Result<V::Value, Error> {
         match self.0 {
-            Value::Boolean(v) => visitor.visit_bool(*v),
-            Value::Integer(n) => visitor.visit_i64(*n),
-            Value::Float(x) => visitor.visit_f64(*x),
-            Value::String(s) => visitor.visit_borrowed_str(s),
-            Value::Datetime(d) => visitor.visit_string(d.to_string()),
-            Value::Array(a) => {
+            Node::Boolean(v) => visitor.visit_bool(*v),
+            Node::Integer(n) => visitor.visit_i64(*n),
+            Node::Float(x) => visitor.visit_f64(*x),
+            Node::String(s) => visitor.visit_borrowed_str(s),
+            Node::Datetime(d) => visitor.visit_string(d.to_string()),
+            Node::Array(_, a) => {
                 let mut seq = Seq(a.iter());
                 let out = visitor.visit_seq(&mut seq)?;
                 match seq.0.len() {
@@ -59,7 +60,7 @@ impl<'de> de::Deserializer<'de> for ValueRef<'de> {
                     )),
                 }
             }
-            Value::Table(t) => visit_table(t, visitor),
+            Node::Table(t) => visit_table(t, visitor),
         }
     }
 
@@ -83,7 +84,7 @@ impl<'de> de::Deserializer<'de> for ValueRef<'de> {
         visitor: V,
     ) -> Result<V::Value, Error> {
         match self.0 {
-            Value::String(s) => visitor.visit_enum(s.as_str().into_deserializer()),
+            Node::String(s) => visitor.visit_enum(s.as_ref().into_deserializer()),
             _ => Err(de::Error::invalid_type(
                 de::Unexpected::UnitVariant,
                 &"string only",
@@ -99,7 +100,7 @@ impl<'de> de::Deserializer<'de> for ValueRef<'de> {
 }
 
 /// A table as a map, read to its end.
-fn visit_table<'de, V: Visitor<'de>>(t: &'de Table, visitor: V) -> Result<V::Value, Error> {
+fn visit_table<'de, V: Visitor<'de>>(t: &'de Table<'_>, visitor: V) -> Result<V::Value, Error> {
     let mut map = Map {
         iter: t.iter(),
         value: None,
@@ -112,9 +113,9 @@ fn visit_table<'de, V: Visitor<'de>>(t: &'de Table, visitor: V) -> Result<V::Val
 }
 
 /// The elements of an array.
-struct Seq<'a>(std::slice::Iter<'a, Value>);
+struct Seq<'a, 'i>(std::slice::Iter<'a, Node<'i>>);
 
-impl<'de> SeqAccess<'de> for Seq<'de> {
+impl<'de> SeqAccess<'de> for Seq<'de, '_> {
     type Error = Error;
 
     fn next_element_seed<T: DeserializeSeed<'de>>(
@@ -133,12 +134,12 @@ impl<'de> SeqAccess<'de> for Seq<'de> {
 }
 
 /// The entries of a table, each key before its value.
-struct Map<'a> {
-    iter: toml::map::Iter<'a, String, Value>,
-    value: Option<&'a Value>,
+struct Map<'a, 'i> {
+    iter: std::slice::Iter<'a, (Cow<'i, str>, Node<'i>)>,
+    value: Option<&'a Node<'i>>,
 }
 
-impl<'de> MapAccess<'de> for Map<'de> {
+impl<'de> MapAccess<'de> for Map<'de, '_> {
     type Error = Error;
 
     fn next_key_seed<K: DeserializeSeed<'de>>(

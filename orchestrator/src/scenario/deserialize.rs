@@ -2,7 +2,8 @@
 //! (unknown key, wrong type, missing field) instead of stopping at the first.
 //!
 //! A valid document is read once, in place (`borrowed`: no copy of the
-//! table). Only when that fails does the collecting pass ([`collect`]) run.
+//! tree `stream` read). Only when that fails does the collecting pass
+//! ([`collect`]) run, on a `toml::Table`.
 //! serde stops at the first error; so after each one the offending value is
 //! removed from a copy of the document and the copy deserialised again, until
 //! it fits (or [`MAX_PROBLEMS`] are found). A missing field that is missing
@@ -12,6 +13,7 @@
 
 use super::borrowed::TableRef;
 use super::schema::Scenario;
+use super::stream;
 use serde::Deserialize;
 use serde_path_to_error::Segment;
 use std::collections::{BTreeMap, BTreeSet};
@@ -101,11 +103,21 @@ impl Removed {
 }
 
 /// `doc` as a [`Scenario`], or every problem found (at most [`MAX_PROBLEMS`]):
-/// read in place first, and only if that fails by [`collect`].
+/// read in place first (through a tree that borrows its strings), and only
+/// if that fails by [`collect`].
 pub fn deserialize(doc: &Table) -> Result<Scenario, Vec<Problem>> {
-    match Scenario::deserialize(TableRef(doc)) {
+    match Scenario::deserialize(TableRef(&stream::Table::of(doc))) {
         Ok(s) => Ok(s),
         Err(_) => collect(doc),
+    }
+}
+
+/// As [`deserialize`], of the tree the fast path read (a copy as a
+/// `toml::Table` is made only for the collecting pass).
+pub(super) fn deserialize_tree(tree: &stream::Table<'_>) -> Result<Scenario, Vec<Problem>> {
+    match Scenario::deserialize(TableRef(tree)) {
+        Ok(s) => Ok(s),
+        Err(_) => collect(&tree.to_toml()),
     }
 }
 

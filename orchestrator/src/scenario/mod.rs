@@ -13,8 +13,11 @@
 //!   the input clipped;
 //! - [`overrides`] — `--set key.path=value`;
 //! - `parse` — text + overrides → document and [`Scenario`], every problem at once;
+//! - `stream` — its fast path from text to document: `toml_parser`'s events
+//!   into a compact tree, a chunk of tokens at a time;
 //! - [`deserialize`] — the document → [`Scenario`], every schema problem;
 //!   `borrowed` — its fast path: the document read in place, without a copy;
+//! - `document` — [`Document`], the effective TOML a run writes;
 //! - [`resolve`] — validation and resolution into the network, one phase per table;
 //! - [`plugin`] — plug-in agents (`[[agent]] command`);
 //! - [`report`] — the text `attsync check` prints;
@@ -22,6 +25,7 @@
 
 mod borrowed;
 pub mod deserialize;
+mod document;
 mod error;
 pub mod input;
 pub mod overrides;
@@ -30,7 +34,9 @@ pub mod plugin;
 pub mod report;
 pub mod resolve;
 pub mod schema;
+mod stream;
 
+pub use document::Document;
 pub use error::ScenarioError;
 pub use resolve::{Issue, Resolved};
 pub use schema::Scenario;
@@ -45,7 +51,7 @@ pub struct Loaded {
     /// The file it came from.
     pub file: PathBuf,
     /// The effective TOML (after `--set`), as written to the results.
-    pub document: toml::Table,
+    pub document: Document,
     /// Typed form.
     pub scenario: Scenario,
     /// Validated network and diagnostics.
@@ -82,7 +88,7 @@ pub fn load_with(
         file: file.to_owned(),
         error,
     })?;
-    load_str_with(file, &text, overrides, check)
+    load_text(file, text, overrides, check)
 }
 
 /// As [`load`], from text already read (`file` is used in messages).
@@ -97,8 +103,18 @@ pub fn load_str_with(
     overrides: &[String],
     check: StiffnessCheck,
 ) -> Result<Loaded, ScenarioError> {
+    load_text(file, text.to_owned(), overrides, check)
+}
+
+/// As [`load_str_with`], keeping `text` as the document.
+fn load_text(
+    file: &Path,
+    text: String,
+    overrides: &[String],
+    check: StiffnessCheck,
+) -> Result<Loaded, ScenarioError> {
     let file_buf = file.to_owned();
-    let (document, scenario) = parse::parse(text, overrides).map_err(|f| match f {
+    let scenario = parse::parse(&text, overrides).map_err(|f| match f {
         parse::Failure::Syntax(issue) => ScenarioError::Parse {
             file: file_buf.clone(),
             issues: vec![issue],
@@ -144,7 +160,7 @@ pub fn load_str_with(
     tracing::debug!(elapsed = ?start.elapsed(), "scenario: resolved");
     Ok(Loaded {
         file: file.to_owned(),
-        document,
+        document: Document::new(text, overrides),
         scenario,
         resolved,
     })

@@ -48,12 +48,79 @@ pub fn path_of(spec: &str) -> Option<&str> {
     spec.split_once('=').map(|(path, _)| path.trim())
 }
 
+/// A document `--set` edits: toml's [`Table`], or the tree the fast path
+/// reads (`scenario::stream`).
+pub trait Tree: Sized {
+    /// Its values.
+    type Value: TreeValue<Tree = Self>;
+    /// The value at `key`.
+    fn get(&self, key: &str) -> Option<&Self::Value>;
+    /// The value at `key`, to change.
+    fn get_mut(&mut self, key: &str) -> Option<&mut Self::Value>;
+    /// The value at `key`, an empty table inserted first if there is none.
+    fn get_or_table(&mut self, key: &str) -> &mut Self::Value;
+    /// Sets `key` to `value`.
+    fn set(&mut self, key: &str, value: Self::Value);
+}
+
+/// A value of a [`Tree`].
+pub trait TreeValue: Sized {
+    /// The tree's tables.
+    type Tree;
+    /// `value` (an override's) as a value of the tree.
+    fn from_toml(value: Value) -> Self;
+    /// The table, if it is one.
+    fn as_table(&self) -> Option<&Self::Tree>;
+    /// The table, to change, if it is one.
+    fn as_table_mut(&mut self) -> Option<&mut Self::Tree>;
+    /// The elements, if it is an array.
+    fn as_array(&self) -> Option<&[Self]>;
+    /// The elements, to change, if it is an array.
+    fn as_array_mut(&mut self) -> Option<&mut [Self]>;
+}
+
+impl Tree for Table {
+    type Value = Value;
+    fn get(&self, key: &str) -> Option<&Value> {
+        Table::get(self, key)
+    }
+    fn get_mut(&mut self, key: &str) -> Option<&mut Value> {
+        Table::get_mut(self, key)
+    }
+    fn get_or_table(&mut self, key: &str) -> &mut Value {
+        self.entry(key)
+            .or_insert_with(|| Value::Table(Table::new()))
+    }
+    fn set(&mut self, key: &str, value: Value) {
+        self.insert(key.to_owned(), value);
+    }
+}
+
+impl TreeValue for Value {
+    type Tree = Table;
+    fn from_toml(value: Value) -> Self {
+        value
+    }
+    fn as_table(&self) -> Option<&Table> {
+        Value::as_table(self)
+    }
+    fn as_table_mut(&mut self) -> Option<&mut Table> {
+        Value::as_table_mut(self)
+    }
+    fn as_array(&self) -> Option<&[Value]> {
+        Value::as_array(self).map(Vec::as_slice)
+    }
+    fn as_array_mut(&mut self) -> Option<&mut [Value]> {
+        Value::as_array_mut(self).map(Vec::as_mut_slice)
+    }
+}
+
 /// Applies one `key.path=value` override to `doc`; on an error `doc` is
 /// left as it was (the path is walked read-only first, so that a large
 /// document need not be copied to keep a half-applied override out).
-pub fn apply(doc: &mut Table, spec: &str) -> Result<(), OverrideError> {
+pub fn apply<T: Tree>(doc: &mut T, spec: &str) -> Result<(), OverrideError> {
     let (path, raw) = spec.split_once('=').ok_or(OverrideError::NoEquals)?;
-    let value = parse_value(raw.trim());
+    let value = T::Value::from_toml(parse_value(raw.trim()));
     let segments = parse_path(path.trim())?;
     check(doc, &segments)?;
     set(doc, &segments, value)
@@ -64,7 +131,7 @@ type Segments = [(String, Option<usize>)];
 
 /// The errors [`set`] would meet on `doc`, without changing it: a missing
 /// key on the way is a table `set` creates (empty: indexing it fails).
-fn check(doc: &Table, segments: &Segments) -> Result<(), OverrideError> {
+fn check<T: Tree>(doc: &T, segments: &Segments) -> Result<(), OverrideError> {
     let (last, parents) = segments
         .split_last()
         .expect("parse_path returns ≥ 1 segment");
@@ -94,15 +161,13 @@ fn check(doc: &Table, segments: &Segments) -> Result<(), OverrideError> {
 }
 
 /// Sets the value at `segments` in `doc`, creating missing tables.
-fn set(doc: &mut Table, segments: &Segments, value: Value) -> Result<(), OverrideError> {
+fn set<T: Tree>(doc: &mut T, segments: &Segments, value: T::Value) -> Result<(), OverrideError> {
     let (last, parents) = segments
         .split_last()
         .expect("parse_path returns ≥ 1 segment");
     let mut table = doc;
     for (key, index) in parents {
-        let entry = table
-            .entry(key.clone())
-            .or_insert_with(|| Value::Table(Table::new()));
+        let entry = table.get_or_table(key);
         let entry = match index {
             Some(k) => index_into(entry, key, *k)?,
             None => entry,
@@ -119,14 +184,12 @@ fn set(doc: &mut Table, segments: &Segments, value: Value) -> Result<(), Overrid
                 .ok_or_else(|| OverrideError::NoArray(key.clone()))?;
             *index_into(entry, key, *k)? = value;
         }
-        None => {
-            table.insert(key.clone(), value);
-        }
+        None => table.set(key, value),
     }
     Ok(())
 }
 
-fn index_ref<'a>(v: &'a Value, key: &str, k: usize) -> Result<&'a Value, OverrideError> {
+fn index_ref<'a, V: TreeValue>(v: &'a V, key: &str, k: usize) -> Result<&'a V, OverrideError> {
     let arr = v
         .as_array()
         .ok_or_else(|| OverrideError::NotAnArray(key.to_owned()))?;
@@ -137,7 +200,11 @@ fn index_ref<'a>(v: &'a Value, key: &str, k: usize) -> Result<&'a Value, Overrid
     })
 }
 
-fn index_into<'a>(v: &'a mut Value, key: &str, k: usize) -> Result<&'a mut Value, OverrideError> {
+fn index_into<'a, V: TreeValue>(
+    v: &'a mut V,
+    key: &str,
+    k: usize,
+) -> Result<&'a mut V, OverrideError> {
     let arr = v
         .as_array_mut()
         .ok_or_else(|| OverrideError::NotAnArray(key.to_owned()))?;

@@ -1,11 +1,15 @@
 //! Text → effective document (after `--set`) → typed [`Scenario`], with
 //! every problem of the overrides and of the schema found in one pass.
+//! The document is `stream`'s tree; toml's own parser reads only a text
+//! that tree refuses (to word its syntax error), and toml's spans are
+//! looked up only for a schema problem.
 
 use super::deserialize::{self, DocPath, Kind, Problem, Seg};
 use super::input::{MAX_QUOTE_CHARS, clip, locate};
 use super::overrides;
 use super::resolve::Issue;
 use super::schema::Scenario;
+use super::stream;
 use std::time::Instant;
 use toml::Table;
 use toml::de::{DeArray, DeTable};
@@ -28,30 +32,20 @@ pub(super) enum Failure {
     },
 }
 
-/// The effective document and its typed form.
-pub(super) fn parse(text: &str, sets: &[String]) -> Result<(Table, Scenario), Failure> {
+/// The typed form of the effective document.
+pub(super) fn parse(text: &str, sets: &[String]) -> Result<Scenario, Failure> {
+    let (document, bad, applied) = effective(text, sets)?;
     let start = Instant::now();
-    let mut document: Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| Failure::Syntax(syntax(text, &e)))?;
-    debug!(bytes = text.len(), elapsed = ?start.elapsed(), "scenario: TOML parsed");
-    let mut bad = Vec::new();
-    let mut applied = Vec::new();
-    for o in sets {
-        // A failed override leaves the document as it was.
-        match overrides::apply(&mut document, o) {
-            Ok(()) => applied.extend(overrides::path_of(o)),
-            Err(e) => bad.push(Issue {
-                field: format!("--set {}", clip(o, MAX_QUOTE_CHARS)),
-                reason: e.to_string(),
-            }),
-        }
-    }
-    let start = Instant::now();
-    let typed = deserialize::deserialize(&document);
-    debug!(elapsed = ?start.elapsed(), ok = typed.is_ok(), "scenario: schema read");
+    let typed = deserialize::deserialize_tree(&document);
+    drop(document);
+    debug!(
+        elapsed = ?start.elapsed(),
+        ok = typed.is_ok(),
+        peak_rss_kb = msgs::telemetry::peak_rss_kb(),
+        "scenario: schema read"
+    );
     match typed {
-        Ok(s) if bad.is_empty() => Ok((document, s)),
+        Ok(s) if bad.is_empty() => Ok(s),
         Ok(_) => Err(Failure::Schema {
             overrides: bad,
             schema: Vec::new(),
@@ -68,6 +62,39 @@ pub(super) fn parse(text: &str, sets: &[String]) -> Result<(Table, Scenario), Fa
             })
         }
     }
+}
+
+/// The effective document (read by [`stream`], else by toml's parser, which
+/// words a syntax error), with every override of `sets` that applies; the
+/// ones that do not as issues, in order; the paths of the ones that do.
+pub(super) fn effective<'a, 's>(
+    text: &'a str,
+    sets: &'s [String],
+) -> Result<(stream::Table<'a>, Vec<Issue>, Vec<&'s str>), Failure> {
+    let start = Instant::now();
+    let mut document = match stream::read(text) {
+        Some(tree) => tree,
+        None => {
+            let table: Table = text
+                .parse()
+                .map_err(|e: toml::de::Error| Failure::Syntax(syntax(text, &e)))?;
+            table.into()
+        }
+    };
+    debug!(bytes = text.len(), elapsed = ?start.elapsed(), "scenario: TOML parsed");
+    let mut bad = Vec::new();
+    let mut applied = Vec::new();
+    for o in sets {
+        // A failed override leaves the document as it was.
+        match overrides::apply(&mut document, o) {
+            Ok(()) => applied.extend(overrides::path_of(o)),
+            Err(e) => bad.push(Issue {
+                field: format!("--set {}", clip(o, MAX_QUOTE_CHARS)),
+                reason: e.to_string(),
+            }),
+        }
+    }
+    Ok((document, bad, applied))
 }
 
 /// A TOML syntax error as `line L, column C: reason: `the line``.
