@@ -285,3 +285,51 @@ pub fn appendix_d_smallest_pivot(
     }
     f.smallest_cholesky_pivot(&g)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A random forest on `n` nodes (each node's parent a uniformly chosen
+    /// earlier node, or none) and a random `Ξ`, from a SplitMix stream.
+    fn forest(n: usize, seed: u64) -> (Vec<(usize, usize)>, Vec<bool>) {
+        let mut x = seed;
+        let mut next = move || {
+            x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = x;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        };
+        let edges = (1..n)
+            .filter_map(|k| {
+                let p = (next() % (k as u64 + 1)) as usize;
+                (p < k).then_some((p, k))
+            })
+            .collect();
+        let xi = (0..n).map(|_| next() % 5 == 0).collect();
+        (edges, xi)
+    }
+
+    /// The forest loop counts what the general loop counts, at every
+    /// threshold a bisection visits (and at the extremes themselves).
+    #[test]
+    fn the_forest_count_is_the_general_count() {
+        for (n, seed) in [(1, 1), (2, 2), (7, 3), (60, 4), (500, 5), (3000, 6)] {
+            let (edges, xi) = forest(n, seed);
+            let m = XiPlusLaplacian::new(n, &edges, &xi);
+            assert!(m.g.is_forest(), "{n}");
+            let (lo, hi) = m.extremes();
+            let mut ts = vec![0.0, lo, hi, -1.0, m.gershgorin, m.diag.0, m.diag.1];
+            ts.extend((0..200).map(|k| lo + (hi - lo) * f64::from(k) / 199.0));
+            ts.extend([lo * (1.0 + 1e-15), lo * (1.0 - 1e-15), hi * (1.0 + 1e-15)]);
+            for t in ts {
+                assert_eq!(
+                    m.a.eigenvalues_below(&m.g, t),
+                    m.a.eigenvalues_below_filled(&m.g, t),
+                    "n = {n}, t = {t}"
+                );
+            }
+        }
+    }
+}
