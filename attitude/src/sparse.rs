@@ -271,15 +271,6 @@ impl ScalarSym {
     /// larger).
     #[must_use]
     pub fn eigenvalues_below(&self, g: &Elimination, t: f64) -> usize {
-        if g.is_forest() {
-            self.eigenvalues_below_on_forest(g, t)
-        } else {
-            self.eigenvalues_below_filled(g, t)
-        }
-    }
-
-    /// [`ScalarSym::eigenvalues_below`] on any pattern (fill-in updated).
-    pub(crate) fn eigenvalues_below_filled(&self, g: &Elimination, t: f64) -> usize {
         let mut r: Vec<f64> = self.excess.iter().map(|x| x - t).collect();
         let mut off = self.off.clone();
         let mut negative = 0;
@@ -306,30 +297,63 @@ impl ScalarSym {
 }
 
 impl ScalarSym {
-    /// [`ScalarSym::eigenvalues_below`] on a pattern where every position has
-    /// at most one later neighbour (a forest, leaves first): no entry is
-    /// updated, so `off` is read in place, and the arithmetic is the general
-    /// loop's, operation for operation (`d = r_v − a_vp`, `r_p −= (a_vp/d) r_v`).
-    fn eigenvalues_below_on_forest(&self, g: &Elimination, t: f64) -> usize {
-        let mut r: Vec<f64> = self.excess.iter().map(|x| x - t).collect();
+    /// The same matrix laid out for a forest's pattern ([`ForestSym`]), if
+    /// every position of `g` has at most one later neighbour.
+    #[must_use]
+    pub fn on_forest(&self, g: &Elimination) -> Option<ForestSym> {
+        if !g.is_forest() {
+            return None;
+        }
+        let n = g.len();
+        let up = (0..n)
+            .map(|v| {
+                let row = g.row(v);
+                match row.len() {
+                    0 => (n, 0.0),
+                    _ => (g.later[row.start], self.off[row.start]),
+                }
+            })
+            .collect();
+        Some(ForestSym {
+            up,
+            excess: self.excess.clone(),
+        })
+    }
+}
+
+/// A [`ScalarSym`] on a forest eliminated leaves first, by position: each
+/// position's one later neighbour and the entry to it. Nothing is filled
+/// in, so a count reads the entries in place, in one pass.
+#[derive(Debug, Clone)]
+pub struct ForestSym {
+    /// Per position: the later neighbour's position and the entry `a_vp`
+    /// (a root: `(n, 0)`, `n` a scratch slot).
+    up: Vec<(usize, f64)>,
+    /// Row sums, by position.
+    excess: Vec<f64>,
+}
+
+impl ForestSym {
+    /// [`ScalarSym::eigenvalues_below`], operation for operation (`d = r_v −
+    /// a_vp`, `r_p −= (a_vp / d) r_v`; a root's `d = r_v − 0 = r_v`), so the
+    /// same count.
+    #[must_use]
+    pub fn eigenvalues_below(&self, t: f64) -> usize {
+        let mut r = Vec::with_capacity(self.excess.len() + 1);
+        r.extend(self.excess.iter().map(|x| x - t));
+        r.push(0.0); // the roots' scratch slot
         let mut negative = 0;
-        for v in 0..g.len() {
-            let (first, end) = (g.start[v], g.start[v + 1]);
-            let later = (first < end).then(|| (g.later[first], self.off[first]));
-            let mut d = match later {
-                Some((_, a)) => r[v] - a,
-                None => r[v],
-            };
+        for (v, &(p, a)) in self.up.iter().enumerate() {
+            let rv = r[v];
+            let mut d = rv - a;
             if d <= 0.0 {
                 negative += 1;
                 if d == 0.0 {
                     d = -f64::EPSILON * (1.0 + t.abs());
                 }
             }
-            if let Some((p, a)) = later {
-                let f = a / d;
-                r[p] -= f * r[v];
-            }
+            let f = a / d;
+            r[p] -= f * rv;
         }
         negative
     }

@@ -194,7 +194,7 @@ fn pick_duration(
             }
             s.simulation.duration = longest;
             let w = format!(
-                "duration = {longest} s: {why}, but a run has at most 2^40 = {MAX_STEPS:e} steps of dt = {dt} s, so the duration is clamped to the longest whole 10 s within them ({longest} s); the run may not converge (a shorter horizon: --duration)"
+                "duration = {longest} s: {why}, more than check allows (at most 2^40 = {MAX_STEPS:e} steps of dt = {dt} s), so it is clamped to the longest whole 10 s within that limit; the run may not converge"
             );
             (Some(w.clone()), Some(w))
         }
