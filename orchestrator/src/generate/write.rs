@@ -199,7 +199,7 @@ fn scenario<W: io::Write>(w: &mut Sink<W>, s: &Scenario) -> fmt::Result {
     let sim = &s.simulation;
     // The first table follows a blank line only if there are values above it.
     let first = if w.buf.is_empty() { "" } else { "\n" };
-    write!(w, "{first}[simulation]\n")?;
+    writeln!(w, "{first}[simulation]")?;
     kv(w, "dt", F(sim.dt))?;
     kv(w, "duration", F(sim.duration))?;
     kv(w, "coupling", enum_name(&sim.coupling))?;
