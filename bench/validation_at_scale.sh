@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
 # Validation at scale (BENCHMARKS.md "Validation at scale"): wall time, CPU
 # time and peak RSS of `attsync gen tree` and `attsync check` on random trees
-# of 10², 10³, 10⁴, 10⁵ agents (seed 1, one leader link, --duration 40: the
-# generated horizon of a deep tree can exceed the step limit, and `check`
-# would then stop before its last phases), every scheme, as a Markdown table
-# on stdout. Usage: bench/validation_at_scale.sh [ATTSYNC] [N…]
+# of 10², 10³, 10⁴, 10⁵ agents (seed 1, one leader link, --duration 40 as
+# in session 5: without it a deep tree's horizon is clamped to the 2⁴⁰-step
+# limit, which changes nothing `check` does), every scheme, as a Markdown
+# table on stdout. Usage: bench/validation_at_scale.sh [ATTSYNC] [N…]
 # (default: target/release/attsync, 100 1000 10000 100000). One run each.
 set -euo pipefail
 bin=$(realpath "${1:-target/release/attsync}")

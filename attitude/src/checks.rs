@@ -18,11 +18,34 @@ pub fn is_spd(m: &Matrix3<f64>) -> bool {
 }
 
 /// Eigenvalues of a symmetric matrix, ascending.
+///
+/// # NOTE
+/// A diagonal matrix (every gain and inertia `gen` writes, most in files)
+/// takes a shortcut with nalgebra's own arithmetic: its symmetric
+/// eigensolver scales the matrix by its largest entry, finds nothing to
+/// rotate and scales back, so its eigenvalues are `(dᵢ / a) · a`, bit for
+/// bit (tested against it).
 #[must_use]
 pub fn sym_eigenvalues(m: &Matrix3<f64>) -> [f64; 3] {
-    let mut e: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+    let mut e = match diagonal(m) {
+        Some(d) => {
+            let a = d.iter().fold(0.0_f64, |a, x| a.max(x.abs()));
+            if a == 0.0 { d } else { d.map(|x| (x / a) * a) }
+        }
+        None => {
+            let e = m.symmetric_eigenvalues();
+            [e[0], e[1], e[2]]
+        }
+    };
     e.sort_by(f64::total_cmp);
-    [e[0], e[1], e[2]]
+    e
+}
+
+/// The diagonal of `m` if every entry off it is zero and every entry is finite.
+fn diagonal(m: &Matrix3<f64>) -> Option<[f64; 3]> {
+    let off_zero = (0..3).all(|i| (0..3).all(|j| i == j || m[(i, j)] == 0.0));
+    let d = [m[(0, 0)], m[(1, 1)], m[(2, 2)]];
+    (off_zero && d.iter().all(|x| x.is_finite())).then_some(d)
 }
 
 /// Whether the symmetric matrix `m` has three distinct eigenvalues (gaps
@@ -133,4 +156,54 @@ pub fn appendix_d_min_eigenvalue(
     appendix_d_f(f1, k_w, k_sigma, p)
         .symmetric_eigenvalues()
         .min()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    /// nalgebra's eigenvalues of a symmetric matrix, ascending (the reference).
+    fn reference(m: &Matrix3<f64>) -> [f64; 3] {
+        let mut e: Vec<f64> = m.symmetric_eigenvalues().iter().copied().collect();
+        e.sort_by(f64::total_cmp);
+        [e[0], e[1], e[2]]
+    }
+
+    #[test]
+    fn the_diagonal_shortcut_gives_nalgebras_eigenvalues_bit_for_bit() {
+        // A SplitMix-like stream: diagonals over many scales and signs.
+        let mut x = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut next = move || {
+            x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = x;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            (z ^ (z >> 31)) as f64 / u64::MAX as f64
+        };
+        for k in 0..200_000 {
+            let scale = 10f64.powi((k % 13) - 6);
+            let mut d = [next(), next(), next()].map(|u| (u - 0.2) * scale * 7.0);
+            if k % 7 == 0 {
+                d[1] = d[0]; // a repeated eigenvalue
+            }
+            let m = Matrix3::from_diagonal(&Vector3::from(d));
+            let (fast, slow) = (sym_eigenvalues(&m), reference(&m));
+            assert_eq!(fast.map(f64::to_bits), slow.map(f64::to_bits), "{d:?}");
+        }
+        for d in [[0.0; 3], [1.0, 0.0, -0.0], [1e-300, 1e300, 2.0]] {
+            let m = Matrix3::from_diagonal(&Vector3::from(d));
+            assert_eq!(
+                sym_eigenvalues(&m).map(f64::to_bits),
+                reference(&m).map(f64::to_bits),
+                "{d:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_full_matrix_goes_to_nalgebra() {
+        let m = Matrix3::new(2.0, 0.5, 0.0, 0.5, 3.0, 0.1, 0.0, 0.1, 4.0);
+        assert_eq!(sym_eigenvalues(&m), reference(&m));
+    }
 }

@@ -1,6 +1,7 @@
-//! Sparse symmetric matrices on a graph: an elimination order (minimum
-//! degree) with its filled pattern, a scalar `LDLᵀ` that counts negative
-//! pivots (Sylvester's law of inertia) and a block Cholesky.
+//! Sparse symmetric matrices on a graph (its [`Adjacency`]): an
+//! elimination order (minimum degree) with its filled pattern, a scalar
+//! `LDLᵀ` that counts negative pivots (Sylvester's law of inertia) and a
+//! block Cholesky.
 //!
 //! On a forest the minimum-degree order eliminates leaves first and never
 //! creates fill-in: every node keeps at most one later neighbour (its
@@ -23,6 +24,8 @@ pub struct Elimination {
     start: Vec<usize>,
     /// Positions of the neighbours eliminated after each position, in the filled graph.
     later: Vec<usize>,
+    /// Every row of `later` holds at most one entry.
+    forest: bool,
 }
 
 impl Elimination {
@@ -34,8 +37,36 @@ impl Elimination {
     /// If an edge names a node `≥ n`.
     #[must_use]
     pub fn min_degree(n: usize, edges: &[(usize, usize)]) -> Self {
-        let rows = forest_rows(n, edges).unwrap_or_else(|| min_degree_rows(n, edges));
-        Self::from_rows(rows)
+        if let Some((order, parent)) = forest_order(n, edges) {
+            return Self::from_parents(order, &parent);
+        }
+        Self::from_rows(min_degree_rows(n, edges))
+    }
+
+    /// From a leaves-first order and each node's one later neighbour (its
+    /// parent, `usize::MAX` for none): the pattern [`Self::from_rows`]
+    /// builds from one-entry rows, without a row per node.
+    fn from_parents(order: Vec<usize>, parent: &[usize]) -> Self {
+        let mut pos = vec![0; order.len()];
+        for (k, &v) in order.iter().enumerate() {
+            pos[v] = k;
+        }
+        let mut start = Vec::with_capacity(order.len() + 1);
+        start.push(0);
+        let mut later = Vec::with_capacity(order.len());
+        for &v in &order {
+            if parent[v] != usize::MAX {
+                later.push(pos[parent[v]]);
+            }
+            start.push(later.len());
+        }
+        Self {
+            order,
+            pos,
+            start,
+            later,
+            forest: true,
+        }
     }
 
     /// From the order and each eliminated node's later neighbours.
@@ -53,11 +84,13 @@ impl Elimination {
             later[first..].sort_unstable();
             start.push(later.len());
         }
+        let forest = start.windows(2).all(|w| w[1] - w[0] <= 1);
         Self {
             order,
             pos,
             start,
             later,
+            forest,
         }
     }
 
@@ -65,6 +98,13 @@ impl Elimination {
     #[must_use]
     pub fn len(&self) -> usize {
         self.order.len()
+    }
+
+    /// Whether every node has at most one later neighbour in the filled
+    /// pattern (a forest eliminated leaves first).
+    #[must_use]
+    pub fn is_forest(&self) -> bool {
+        self.forest
     }
 
     /// Whether the graph has no node.
@@ -114,33 +154,72 @@ impl Elimination {
     }
 }
 
-/// Leaves first, if the graph is a forest (`None` otherwise): each node's
-/// later neighbour is its one remaining neighbour when it is peeled.
-fn forest_rows(n: usize, edges: &[(usize, usize)]) -> Option<(Vec<usize>, Vec<Vec<usize>>)> {
-    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for &(i, j) in edges.iter().filter(|(i, j)| i != j) {
-        adj[i].push(j);
-        adj[j].push(i);
+/// The edges at every node of a graph, in compressed rows: `(other end,
+/// edge index)` in the order of the edges (self-loops left out).
+#[derive(Debug, Clone)]
+pub struct Adjacency {
+    start: Vec<usize>,
+    at: Vec<(usize, usize)>,
+}
+
+impl Adjacency {
+    /// Both directions of every edge `(i, j)`, `i ≠ j`, among nodes `0..n`.
+    ///
+    /// # Panics
+    /// If an edge names a node `≥ n`.
+    #[must_use]
+    pub fn new(n: usize, edges: &[(usize, usize)]) -> Self {
+        let edges = || edges.iter().enumerate().filter(|(_, (i, j))| i != j);
+        let mut start = vec![0; n + 1];
+        for (_, &(i, j)) in edges() {
+            start[i + 1] += 1;
+            start[j + 1] += 1;
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut at = vec![(0, 0); start[n]];
+        for (e, &(i, j)) in edges() {
+            at[fill[i]] = (j, e);
+            fill[i] += 1;
+            at[fill[j]] = (i, e);
+            fill[j] += 1;
+        }
+        Self { start, at }
     }
-    let mut degree: Vec<usize> = adj.iter().map(Vec::len).collect();
+
+    /// `(other end, edge index)` of every edge at node `v`.
+    #[must_use]
+    pub fn of(&self, v: usize) -> &[(usize, usize)] {
+        &self.at[self.start[v]..self.start[v + 1]]
+    }
+}
+
+/// Leaves first, if the graph is a forest (`None` otherwise): the order and
+/// each node's later neighbour, its one remaining neighbour when it is
+/// peeled (`usize::MAX` for a root).
+fn forest_order(n: usize, edges: &[(usize, usize)]) -> Option<(Vec<usize>, Vec<usize>)> {
+    let adj = Adjacency::new(n, edges);
+    let mut degree: Vec<usize> = (0..n).map(|v| adj.of(v).len()).collect();
     let mut queue: std::collections::VecDeque<usize> = (0..n).filter(|&v| degree[v] <= 1).collect();
     let mut done = vec![false; n];
-    let (mut order, mut rows) = (Vec::with_capacity(n), vec![Vec::new(); n]);
+    let (mut order, mut parent) = (Vec::with_capacity(n), vec![usize::MAX; n]);
     while let Some(v) = queue.pop_front() {
         done[v] = true;
         order.push(v);
-        rows[v] = adj[v].iter().copied().filter(|&u| !done[u]).collect();
-        if rows[v].len() > 1 {
+        let mut later = adj.of(v).iter().map(|&(u, _)| u).filter(|&u| !done[u]);
+        let Some(u) = later.next() else { continue };
+        if later.next().is_some() {
             return None; // a repeated pair: not a forest
         }
-        for &u in &rows[v] {
-            degree[u] -= 1;
-            if degree[u] == 1 {
-                queue.push_back(u);
-            }
+        parent[v] = u;
+        degree[u] -= 1;
+        if degree[u] == 1 {
+            queue.push_back(u);
         }
     }
-    (order.len() == n).then_some((order, rows))
+    (order.len() == n).then_some((order, parent))
 }
 
 /// Minimum degree with explicit fill-in (any graph).
@@ -212,6 +291,69 @@ impl ScalarSym {
                     off[k] -= f * off[ib];
                 }
             }
+        }
+        negative
+    }
+}
+
+impl ScalarSym {
+    /// The same matrix laid out for a forest's pattern ([`ForestSym`]), if
+    /// every position of `g` has at most one later neighbour.
+    #[must_use]
+    pub fn on_forest(&self, g: &Elimination) -> Option<ForestSym> {
+        if !g.is_forest() {
+            return None;
+        }
+        let n = g.len();
+        let up = (0..n)
+            .map(|v| {
+                let row = g.row(v);
+                match row.len() {
+                    0 => (n, 0.0),
+                    _ => (g.later[row.start], self.off[row.start]),
+                }
+            })
+            .collect();
+        Some(ForestSym {
+            up,
+            excess: self.excess.clone(),
+        })
+    }
+}
+
+/// A [`ScalarSym`] on a forest eliminated leaves first, by position: each
+/// position's one later neighbour and the entry to it. Nothing is filled
+/// in, so a count reads the entries in place, in one pass.
+#[derive(Debug, Clone)]
+pub struct ForestSym {
+    /// Per position: the later neighbour's position and the entry `a_vp`
+    /// (a root: `(n, 0)`, `n` a scratch slot).
+    up: Vec<(usize, f64)>,
+    /// Row sums, by position.
+    excess: Vec<f64>,
+}
+
+impl ForestSym {
+    /// [`ScalarSym::eigenvalues_below`], operation for operation (`d = r_v −
+    /// a_vp`, `r_p −= (a_vp / d) r_v`; a root's `d = r_v − 0 = r_v`), so the
+    /// same count.
+    #[must_use]
+    pub fn eigenvalues_below(&self, t: f64) -> usize {
+        let mut r = Vec::with_capacity(self.excess.len() + 1);
+        r.extend(self.excess.iter().map(|x| x - t));
+        r.push(0.0); // the roots' scratch slot
+        let mut negative = 0;
+        for (v, &(p, a)) in self.up.iter().enumerate() {
+            let rv = r[v];
+            let mut d = rv - a;
+            if d <= 0.0 {
+                negative += 1;
+                if d == 0.0 {
+                    d = -f64::EPSILON * (1.0 + t.abs());
+                }
+            }
+            let f = a / d;
+            r[p] -= f * rv;
         }
         negative
     }

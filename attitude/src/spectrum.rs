@@ -9,7 +9,7 @@
 //! found by bisection on that count, `O(N log(1/ε))`. Other graphs work too
 //! (with fill-in).
 
-use crate::sparse::{Block, BlockSym, Elimination, ScalarSym};
+use crate::sparse::{Block, BlockSym, Elimination, ForestSym, ScalarSym};
 use nalgebra::Matrix3;
 
 /// Relative width at which a bisection stops (a few ulps).
@@ -20,6 +20,9 @@ const REL: f64 = 4.0 * f64::EPSILON;
 pub struct XiPlusLaplacian {
     g: Elimination,
     a: ScalarSym,
+    /// `a` laid out for a forest (every graph of Assumption 1): its counts
+    /// take one pass, the same arithmetic.
+    forest: Option<ForestSym>,
     /// Smallest and largest diagonal entry (`λmin ≤` the first, `λmax ≥` the second).
     diag: (f64, f64),
     /// Gershgorin's bound on `λmax`.
@@ -54,9 +57,11 @@ impl XiPlusLaplacian {
         let gershgorin = (0..n)
             .map(|i| 2.0 * degree[i] + xi_i(i))
             .fold(0.0, f64::max);
+        let a = ScalarSym { excess, off };
         Self {
+            forest: a.on_forest(&g),
             g,
-            a: ScalarSym { excess, off },
+            a,
             diag,
             gershgorin,
         }
@@ -77,7 +82,10 @@ impl XiPlusLaplacian {
     /// Number of eigenvalues below `t` (Sylvester's law of inertia on `LDLᵀ`).
     #[must_use]
     pub fn eigenvalues_below(&self, t: f64) -> usize {
-        self.a.eigenvalues_below(&self.g, t)
+        match &self.forest {
+            Some(f) => f.eigenvalues_below(t),
+            None => self.a.eigenvalues_below(&self.g, t),
+        }
     }
 
     /// `(λmin, λmax)`, each to a few ulps of the bisection (the count's own
@@ -284,4 +292,52 @@ pub fn appendix_d_smallest_pivot(
         }
     }
     f.smallest_cholesky_pivot(&g)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A random forest on `n` nodes (each node's parent a uniformly chosen
+    /// earlier node, or none) and a random `Ξ`, from a SplitMix stream.
+    fn forest(n: usize, seed: u64) -> (Vec<(usize, usize)>, Vec<bool>) {
+        let mut x = seed;
+        let mut next = move || {
+            x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = x;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        };
+        let edges = (1..n)
+            .filter_map(|k| {
+                let p = (next() % (k as u64 + 1)) as usize;
+                (p < k).then_some((p, k))
+            })
+            .collect();
+        let xi = (0..n).map(|_| next() % 5 == 0).collect();
+        (edges, xi)
+    }
+
+    /// The forest loop counts what the general loop counts, at every
+    /// threshold a bisection visits (and at the extremes themselves).
+    #[test]
+    fn the_forest_count_is_the_general_count() {
+        for (n, seed) in [(1, 1), (2, 2), (7, 3), (60, 4), (500, 5), (3000, 6)] {
+            let (edges, xi) = forest(n, seed);
+            let m = XiPlusLaplacian::new(n, &edges, &xi);
+            assert!(m.forest.is_some(), "{n}");
+            let (lo, hi) = m.extremes();
+            let mut ts = vec![0.0, lo, hi, -1.0, m.gershgorin, m.diag.0, m.diag.1];
+            ts.extend((0..200).map(|k| lo + (hi - lo) * f64::from(k) / 199.0));
+            ts.extend([lo * (1.0 + 1e-15), lo * (1.0 - 1e-15), hi * (1.0 + 1e-15)]);
+            for t in ts {
+                assert_eq!(
+                    m.eigenvalues_below(t),
+                    m.a.eigenvalues_below(&m.g, t),
+                    "n = {n}, t = {t}"
+                );
+            }
+        }
+    }
 }

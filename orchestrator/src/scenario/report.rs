@@ -12,7 +12,8 @@ use std::fmt::Write as _;
 pub fn describe(l: &Loaded) -> String {
     let r = &l.resolved;
     let n = &r.network;
-    let mut s = String::new();
+    // ~70 bytes per agent line and ~14 per edge: one allocation.
+    let mut s = String::with_capacity(4096 + 90 * n.agents.len());
     let _ = writeln!(s, "{}: OK", l.file.display());
     let _ = writeln!(s, "name:      {}", l.name());
     let _ = writeln!(s, "scheme:    {}", kind_name(l.scenario.scheme.kind));
@@ -31,34 +32,18 @@ pub fn describe(l: &Loaded) -> String {
         n.steps as f64 * n.dt
     );
     let _ = writeln!(s, "agents:    {}", n.agents.len());
-    for a in &n.agents {
-        let nb: Vec<String> = a
-            .model
-            .neighbours
-            .iter()
-            .map(|x| x.id.to_string())
-            .collect();
-        let _ = writeln!(
-            s,
-            "  agent {:>3}  J diag {:?}  neighbours [{}]{}",
-            a.model.id,
-            [
-                a.model.inertia.j[(0, 0)],
-                a.model.inertia.j[(1, 1)],
-                a.model.inertia.j[(2, 2)]
-            ],
-            nb.join(", "),
-            if a.model.leader_gain.is_some() {
-                "  + leader"
-            } else {
-                ""
-            }
-        );
+    agents(&mut s, n);
+    s.push_str("edges:     ");
+    for (k, (a, b)) in r.edges.iter().enumerate() {
+        let sep = if k == 0 { "" } else { ", " };
+        let _ = write!(s, "{sep}{a}–{b}");
     }
-    let edges: Vec<String> = r.edges.iter().map(|(a, b)| format!("{a}–{b}")).collect();
-    let _ = writeln!(s, "edges:     {}", edges.join(", "));
-    let links: Vec<String> = r.leader_links.iter().map(|a| format!("0→{a}")).collect();
-    let _ = writeln!(s, "leader:    {}", links.join(", "));
+    s.push_str("\nleader:    ");
+    for (k, a) in r.leader_links.iter().enumerate() {
+        let sep = if k == 0 { "" } else { ", " };
+        let _ = write!(s, "{sep}0→{a}");
+    }
+    s.push('\n');
     let (lo, hi) = r.spectrum_extremes;
     let _ = writeln!(
         s,
@@ -83,6 +68,31 @@ pub fn describe(l: &Loaded) -> String {
         let _ = writeln!(s, "warning: {w}");
     }
     s
+}
+
+/// One line per agent: id, the diagonal of `J`, neighbours, `+ leader`.
+fn agents(s: &mut String, n: &attitude::network::Network) {
+    for a in &n.agents {
+        let (m, j) = (&a.model, &a.model.inertia.j);
+        let _ = write!(
+            s,
+            "  agent {:>3}  J diag [{:?}, {:?}, {:?}]  neighbours [",
+            m.id,
+            j[(0, 0)],
+            j[(1, 1)],
+            j[(2, 2)]
+        );
+        for (k, x) in m.neighbours.iter().enumerate() {
+            let sep = if k == 0 { "" } else { ", " };
+            let _ = write!(s, "{sep}{}", x.id);
+        }
+        let leader = if m.leader_gain.is_some() {
+            "  + leader"
+        } else {
+            ""
+        };
+        let _ = writeln!(s, "]{leader}");
+    }
 }
 
 /// The step-size estimate (`docs/stiffness.md`): per loop its fastest linear

@@ -1,12 +1,12 @@
 //! `[[agent]]`: ids, bodies, initial states and control gains `Āᵢ`.
 
 use super::ctx::Ctx;
+use super::ids::Ids;
 use super::kind_name;
 use crate::scenario::schema::{AgentSpec, ObserverInit, SchemeKind};
 use attitude::body::Inertia;
 use attitude::network::AgentState;
 use nalgebra::{Matrix3, Vector3};
-use std::collections::BTreeMap;
 use std::fmt::Display;
 
 /// An agent's body, `Āᵢ` and initial state.
@@ -15,18 +15,27 @@ pub(super) type Body = (Inertia, Matrix3<f64>, AgentState);
 /// The observer's initial state `(R̂ᵢ, ω̂ᵢ, σ̂ᵢ)`.
 type ObserverState = (Matrix3<f64>, Vector3<f64>, Vector3<f64>);
 
-/// Agent id → its index in `[[agent]]` (the first, if repeated).
-pub(super) fn ids(c: &mut Ctx, agents: &[AgentSpec]) -> BTreeMap<u32, usize> {
-    let mut ids: BTreeMap<u32, usize> = BTreeMap::new();
-    for (k, a) in agents.iter().enumerate() {
-        if a.id == 0 {
-            c.err(format!("agent[{k}].id"), "must be ≥ 1 (id 0 is the leader)");
-        } else if let Some(first) = ids.insert(a.id, k) {
-            c.err(
-                format!("agent[{k}].id"),
-                format!("duplicate id {} (also agent[{first}])", a.id),
-            );
-            ids.insert(a.id, first);
+/// The agents' ids ([`Ids`]), with an error for id 0 and for every
+/// repeated id, in file order.
+pub(super) fn ids(c: &mut Ctx, agents: &[AgentSpec]) -> Ids {
+    let pairs = agents
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a.id != 0)
+        .map(|(k, a)| (a.id, k))
+        .collect();
+    let (ids, repeats) = Ids::new(pairs);
+    let mut repeats = repeats.into_iter().peekable();
+    if repeats.peek().is_some() || agents.iter().any(|a| a.id == 0) {
+        for (k, a) in agents.iter().enumerate() {
+            if a.id == 0 {
+                c.err(format!("agent[{k}].id"), "must be ≥ 1 (id 0 is the leader)");
+            } else if let Some((_, first)) = repeats.next_if(|&(later, _)| later == k) {
+                c.err(
+                    format!("agent[{k}].id"),
+                    format!("duplicate id {} (also agent[{first}])", a.id),
+                );
+            }
         }
     }
     if agents.is_empty() {
@@ -35,12 +44,18 @@ pub(super) fn ids(c: &mut Ctx, agents: &[AgentSpec]) -> BTreeMap<u32, usize> {
     ids
 }
 
-/// Every valid agent's body, by id.
-pub(super) fn bodies(c: &mut Ctx, agents: &[AgentSpec], kind: SchemeKind) -> BTreeMap<u32, Body> {
-    let mut bodies = BTreeMap::new();
+/// Every valid agent's body, by rank of its id (`None` where invalid).
+pub(super) fn bodies(
+    c: &mut Ctx,
+    agents: &[AgentSpec],
+    kind: SchemeKind,
+    ids: &Ids,
+) -> Vec<Option<Body>> {
+    let mut bodies: Vec<Option<Body>> = vec![None; ids.len()];
     for (k, a) in agents.iter().enumerate() {
-        if let Some(b) = body(c, format_args!("agent[{k}]"), a, kind) {
-            bodies.insert(a.id, b);
+        let b = body(c, format_args!("agent[{k}]"), a, kind);
+        if let (Some(b), Some(r)) = (b, ids.rank(a.id)) {
+            bodies[r] = Some(b);
         }
     }
     bodies

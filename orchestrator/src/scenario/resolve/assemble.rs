@@ -2,7 +2,8 @@
 //! once there are no errors.
 
 use super::agents::Body;
-use super::graph::{Edges, LeaderLinks};
+use super::graph::{Adjacency, Edges, LeaderLinks};
+use super::ids::Ids;
 use super::leader::Leader;
 use super::simulation::Timing;
 use attitude::control::ControlLaw;
@@ -17,17 +18,26 @@ pub(super) struct Parts {
     pub(super) scheme: Option<Scheme>,
     pub(super) time: Timing,
     pub(super) leader: Leader,
-    pub(super) bodies: BTreeMap<u32, Body>,
+    /// By rank of the agents' ids.
+    pub(super) bodies: Vec<Option<Body>>,
     pub(super) impaired: BTreeMap<(u32, u32), LinkModel>,
     pub(super) guard: Envelope,
     pub(super) law: ControlLaw,
 }
 
-/// The network of `parts` over `edges` and `links`.
+/// The graph the agents are wired by.
+pub(super) struct Graph<'a> {
+    pub(super) ids: &'a Ids,
+    pub(super) edges: &'a Edges,
+    pub(super) adjacency: &'a Adjacency,
+    pub(super) links: &'a LeaderLinks,
+}
+
+/// The network of `parts` over `graph`.
 ///
 /// # Panics
 /// If a part is missing: call it only when no phase reported an error.
-pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Network {
+pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
     let Parts {
         scheme,
         time,
@@ -39,27 +49,26 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
     } = parts;
     let scheme = scheme.expect("no errors");
     let p = leader.p;
-    let incident = incident_edges(edges);
     let agents = bodies
         .into_iter()
-        .map(|(id, (inertia, a_bar, initial))| AgentSpec {
-            model: AgentModel {
-                id,
-                inertia,
-                a_bar,
-                neighbours: neighbours(
+        .enumerate()
+        .map(|(r, body)| {
+            let (inertia, a_bar, initial) = body.expect("no errors");
+            let id = graph.ids.id(r);
+            AgentSpec {
+                model: AgentModel {
                     id,
-                    incident.get(&id).map_or(&[], Vec::as_slice),
-                    edges,
-                    &impaired,
-                ),
-                leader_gain: links.gain.get(&id).copied(),
-                leader_link: impaired.get(&(0, id)).copied(),
-                scheme,
-                p,
-                law,
-            },
-            initial,
+                    inertia,
+                    a_bar,
+                    neighbours: neighbours(id, r, graph, &impaired),
+                    leader_gain: graph.links.gain[r],
+                    leader_link: impaired.get(&(0, id)).copied(),
+                    scheme,
+                    p,
+                    law,
+                },
+                initial,
+            }
         })
         .collect();
     Network {
@@ -78,35 +87,27 @@ pub(super) fn network(parts: Parts, edges: &Edges, links: &LeaderLinks) -> Netwo
     }
 }
 
-/// The neighbours of agent `id`, by ascending id, with the link each of
-/// their messages to `id` crosses (`incident`: the edges at `id`).
+/// The neighbours of agent `id` (rank `r`), by ascending id, with the link
+/// each of their messages to `id` crosses.
 fn neighbours(
     id: u32,
-    incident: &[(u32, u32)],
-    edges: &Edges,
+    r: usize,
+    graph: &Graph<'_>,
     impaired: &BTreeMap<(u32, u32), LinkModel>,
 ) -> Vec<Neighbour> {
-    let mut neighbours: Vec<Neighbour> = incident
+    let mut neighbours: Vec<Neighbour> = graph
+        .adjacency
+        .of(r)
         .iter()
-        .map(|&(a, b)| {
-            let other = if a == id { b } else { a };
+        .map(|&(other, e)| {
+            let other = graph.ids.id(other);
             Neighbour {
                 link: impaired.get(&(other, id)).copied(),
                 id: other,
-                a: edges.gain[&(a, b)],
+                a: graph.edges.gain[e].expect("no errors"),
             }
         })
         .collect();
     neighbours.sort_by_key(|n| n.id);
     neighbours
-}
-
-/// The edges at every agent, in file order (one pass over the edges).
-fn incident_edges(edges: &Edges) -> BTreeMap<u32, Vec<(u32, u32)>> {
-    let mut at: BTreeMap<u32, Vec<(u32, u32)>> = BTreeMap::new();
-    for &(a, b) in &edges.pairs {
-        at.entry(a).or_default().push((a, b));
-        at.entry(b).or_default().push((a, b));
-    }
-    at
 }

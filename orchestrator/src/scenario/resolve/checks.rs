@@ -3,42 +3,41 @@
 //! (Appendix D).
 
 use super::ctx::Ctx;
-use super::graph::{Edges, LeaderLinks};
+use super::graph::{Adjacency, LeaderLinks};
+use super::ids::Ids;
 use attitude::checks::{
     appendix_d_min_eigenvalue_from_extremes, xi_plus_laplacian, xi_plus_laplacian_extremes,
 };
 use attitude::network::Scheme;
 use nalgebra::{DMatrix, Matrix3};
-use std::collections::{BTreeMap, BTreeSet};
 
 /// Every agent of `ids` must be reachable from the leader through edges
 /// (checked only when there is a leader link at all).
 pub(super) fn reachability(
     c: &mut Ctx,
-    ids: &BTreeMap<u32, usize>,
-    edges: &Edges,
+    ids: &Ids,
+    adj: &Adjacency,
     links: &LeaderLinks,
     any_link: bool,
 ) {
-    let mut adj: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
-    for &(a, b) in &edges.pairs {
-        adj.entry(a).or_default().push(b);
-        adj.entry(b).or_default().push(a);
+    if !any_link {
+        return;
     }
-    let mut reached: BTreeSet<u32> = links.seen.keys().copied().collect();
-    let mut stack: Vec<u32> = reached.iter().copied().collect();
+    let mut reached = vec![false; ids.len()];
+    let mut stack: Vec<usize> = links.linked().collect();
+    for &r in &stack {
+        reached[r] = true;
+    }
     while let Some(x) = stack.pop() {
-        for &y in adj.get(&x).map(Vec::as_slice).unwrap_or(&[]) {
-            if reached.insert(y) {
+        for &(y, _) in adj.of(x) {
+            if !reached[y] {
+                reached[y] = true;
                 stack.push(y);
             }
         }
     }
-    if !any_link {
-        return;
-    }
-    for (&id, &k) in ids {
-        if !reached.contains(&id) {
+    for (r, (id, k)) in ids.iter().enumerate() {
+        if !reached[r] {
             c.err(
                 format!("agent[{k}]"),
                 format!("agent {id} is not reachable from the leader: no [[leader_link]] in its connected component (Assumption 1)"),
@@ -69,21 +68,14 @@ pub(super) struct Spectrum {
 /// consistent scenario) Appendix D's condition, a warning when it fails.
 pub(super) fn spectrum(
     c: &mut Ctx,
-    ids: &BTreeMap<u32, usize>,
-    edges: &Edges,
+    idx_edges: &[(usize, usize)],
     links: &LeaderLinks,
     scheme: Option<&Scheme>,
     p: &Matrix3<f64>,
 ) -> Spectrum {
-    let index: BTreeMap<u32, usize> = ids.keys().enumerate().map(|(i, &id)| (id, i)).collect();
-    let idx_edges: Vec<(usize, usize)> = edges
-        .pairs
-        .iter()
-        .map(|(a, b)| (index[a], index[b]))
-        .collect();
-    let xi: Vec<bool> = ids.keys().map(|id| links.seen.contains_key(id)).collect();
-    let n = ids.len();
-    let (lambda_min, lambda_max) = xi_plus_laplacian_extremes(n, &idx_edges, &xi);
+    let xi: Vec<bool> = links.seen.iter().map(Option::is_some).collect();
+    let n = xi.len();
+    let (lambda_min, lambda_max) = xi_plus_laplacian_extremes(n, idx_edges, &xi);
     let mut appendix_d_min_eig = None;
     if let Some(Scheme::ObserverTimeVarying { observer, .. }) = scheme {
         if c.errors.is_empty() {
@@ -103,7 +95,7 @@ pub(super) fn spectrum(
         }
     }
     let eigenvalues = if n <= FULL_SPECTRUM_UP_TO {
-        sorted_eigs(&xi_plus_laplacian(n, &idx_edges, &xi))
+        sorted_eigs(&xi_plus_laplacian(n, idx_edges, &xi))
     } else {
         Vec::new()
     };

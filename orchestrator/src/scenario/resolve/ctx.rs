@@ -13,7 +13,7 @@ use std::fmt::Display;
 
 /// Most steps a run (or a period) may have: 2⁴⁰ ≈ 1.1e12, far beyond any
 /// useful run, well inside u64 and f64's exact integers.
-const MAX_STEPS: f64 = 1_099_511_627_776.0;
+pub const MAX_STEPS: f64 = 1_099_511_627_776.0;
 
 /// Errors and warnings collected by every phase, in the order found.
 #[derive(Default)]

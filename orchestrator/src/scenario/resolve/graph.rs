@@ -2,9 +2,11 @@
 //! leader, with their gains (Assumption 1).
 
 use super::ctx::Ctx;
+use super::ids::Ids;
 use crate::scenario::schema::{EdgeSpec, LeaderLinkSpec};
+pub(super) use attitude::sparse::Adjacency;
 use nalgebra::Matrix3;
-use std::collections::BTreeMap;
+use std::collections::HashMap;
 use std::fmt;
 
 /// The follower edges that name two known, distinct agents.
@@ -12,30 +14,64 @@ use std::fmt;
 pub(super) struct Edges {
     /// Agent-id pairs (smaller id first), in file order.
     pub(super) pairs: Vec<(u32, u32)>,
-    /// The gain of every edge whose gain is valid.
-    pub(super) gain: BTreeMap<(u32, u32), Matrix3<f64>>,
+    /// The gain of each pair, where the gain is valid.
+    pub(super) gain: Vec<Option<Matrix3<f64>>>,
 }
 
-/// The agents that hear the leader.
-#[derive(Default)]
+/// The agents that hear the leader, by rank of their ids.
 pub(super) struct LeaderLinks {
-    /// Agent id → index in `[[leader_link]]`, for every known agent linked.
-    pub(super) seen: BTreeMap<u32, usize>,
-    /// Agent id → gain, where the gain is valid.
-    pub(super) gain: BTreeMap<u32, Matrix3<f64>>,
+    /// Index in `[[leader_link]]` of the link to each agent, if linked.
+    pub(super) seen: Vec<Option<usize>>,
+    /// The gain of each linked agent, where the gain is valid.
+    pub(super) gain: Vec<Option<Matrix3<f64>>>,
+}
+
+impl LeaderLinks {
+    /// Ranks of the linked agents, ascending.
+    pub(super) fn linked(&self) -> impl Iterator<Item = usize> + '_ {
+        self.seen
+            .iter()
+            .enumerate()
+            .filter_map(|(r, k)| k.map(|_| r))
+    }
+}
+
+impl Edges {
+    /// The pairs as pairs of ranks (every pair names known agents).
+    pub(super) fn ranks(&self, ids: &Ids) -> Vec<(usize, usize)> {
+        let rank = |id| ids.rank(id).expect("an edge between known agents");
+        self.pairs
+            .iter()
+            .map(|&(a, b)| (rank(a), rank(b)))
+            .collect()
+    }
 }
 
 /// `[[edge]]` between the agents of `ids`.
-pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &BTreeMap<u32, usize>) -> Edges {
+pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &Ids) -> Edges {
     let mut out = Edges::default();
-    let mut first_edge: BTreeMap<(u32, u32), usize> = BTreeMap::new();
-    let mut dsu = Dsu::default();
+    // The file index of every pair in `out`; the first index of each pair
+    // only once two ends were found connected already (never on a forest).
+    let mut index: Vec<usize> = Vec::with_capacity(specs.len());
+    let mut first_edge: Option<HashMap<(u32, u32), usize>> = None;
+    let mut dsu = Dsu::new(ids.len());
     for (k, e) in specs.iter().enumerate() {
         let f = Edge(k);
         let [a, b] = e.agents;
         let key = (a.min(b), a.max(b));
-        let ok = endpoints_ok(c, f, e.agents, ids) && {
-            let first = first_edge.get(&key);
+        let ends = endpoints_ok(c, f, e.agents, ids).then(|| {
+            let (ra, rb) = (ids.rank(key.0), ids.rank(key.1));
+            (ra.expect("known"), rb.expect("known"))
+        });
+        // A repeated pair is connected already: look it up only then.
+        let joined = ends.is_some_and(|(ra, rb)| dsu.find(ra) == dsu.find(rb));
+        let ok = ends.is_some() && {
+            let first = joined
+                .then(|| {
+                    let map = first_edge.get_or_insert_with(|| pairs_at(&out.pairs, &index));
+                    map.get(&key).copied()
+                })
+                .flatten();
             if let Some(first) = first {
                 c.err(
                     format!("{f}.agents"),
@@ -45,28 +81,40 @@ pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &BTreeMap<u32, usize>)
             first.is_none()
         };
         let g = c.gain(format_args!("{f}.gain"), &e.gain);
-        if ok {
-            first_edge.insert(key, k);
-            if !dsu.union(key.0, key.1) {
+        if let (true, Some((ra, rb))) = (ok, ends) {
+            if let Some(map) = first_edge.as_mut() {
+                map.insert(key, k);
+            }
+            if joined {
                 c.err(
                     format!("{f}.agents"),
                     format!("edge {}–{} closes a cycle: the follower graph must be a forest (Assumption 1)", key.0, key.1),
                 );
+            } else {
+                dsu.union(ra, rb);
             }
             out.pairs.push(key);
-            if let Some(g) = g {
-                out.gain.insert(key, g);
-            }
+            out.gain.push(g);
+            index.push(k);
         }
     }
     out
 }
 
+/// Pair → first file index, of the pairs kept so far.
+fn pairs_at(pairs: &[(u32, u32)], index: &[usize]) -> HashMap<(u32, u32), usize> {
+    let mut map = HashMap::with_capacity(pairs.len());
+    for (&key, &k) in pairs.iter().zip(index) {
+        map.entry(key).or_insert(k);
+    }
+    map
+}
+
 /// Both ends of edge `f` are known agents, and distinct.
-fn endpoints_ok(c: &mut Ctx, f: Edge, [a, b]: [u32; 2], ids: &BTreeMap<u32, usize>) -> bool {
+fn endpoints_ok(c: &mut Ctx, f: Edge, [a, b]: [u32; 2], ids: &Ids) -> bool {
     let mut ok = true;
     for x in [a, b] {
-        if !ids.contains_key(&x) {
+        if !ids.contains(x) {
             c.err(
                 format!("{f}.agents"),
                 format!(
@@ -89,22 +137,22 @@ fn endpoints_ok(c: &mut Ctx, f: Edge, [a, b]: [u32; 2], ids: &BTreeMap<u32, usiz
 }
 
 /// `[[leader_link]]` to the agents of `ids`.
-pub(super) fn leader_links(
-    c: &mut Ctx,
-    specs: &[LeaderLinkSpec],
-    ids: &BTreeMap<u32, usize>,
-) -> LeaderLinks {
-    let mut out = LeaderLinks::default();
+pub(super) fn leader_links(c: &mut Ctx, specs: &[LeaderLinkSpec], ids: &Ids) -> LeaderLinks {
+    let mut out = LeaderLinks {
+        seen: vec![None; ids.len()],
+        gain: vec![None; ids.len()],
+    };
     for (k, l) in specs.iter().enumerate() {
         let g = c.gain(format_args!("leader_link[{k}].gain"), &l.gain);
-        if !ids.contains_key(&l.agent) {
+        let Some(r) = ids.rank(l.agent) else {
             c.err(
                 format!("leader_link[{k}].agent"),
                 format!("unknown agent id {}", l.agent),
             );
             continue;
-        }
-        if let Some(first) = out.seen.insert(l.agent, k) {
+        };
+        // `seen` keeps the latest index: a third link to an agent names the second.
+        if let Some(first) = out.seen[r].replace(k) {
             c.err(
                 format!("leader_link[{k}].agent"),
                 format!(
@@ -114,9 +162,7 @@ pub(super) fn leader_links(
             );
             continue;
         }
-        if let Some(g) = g {
-            out.gain.insert(l.agent, g);
-        }
+        out.gain[r] = g;
     }
     if specs.is_empty() {
         c.err(
@@ -137,34 +183,33 @@ impl fmt::Display for Edge {
     }
 }
 
-/// Union–find over agent ids, for the forest check.
-#[derive(Default)]
+/// Union–find over agent ranks, for the forest check.
 struct Dsu {
-    parent: BTreeMap<u32, u32>,
+    parent: Vec<usize>,
 }
 
 impl Dsu {
-    /// The representative of `x`'s set (iterative, with path halving: no
-    /// recursion however deep the chain of parents).
-    fn find(&mut self, mut x: u32) -> u32 {
-        loop {
-            let p = *self.parent.entry(x).or_insert(x);
-            if p == x {
-                return x;
-            }
-            let g = self.parent[&p];
-            self.parent.insert(x, g);
-            x = g;
+    /// `n` singletons.
+    fn new(n: usize) -> Self {
+        Self {
+            parent: (0..n).collect(),
         }
     }
 
-    /// Joins the sets of `a` and `b`; `false` if they were already joined.
-    fn union(&mut self, a: u32, b: u32) -> bool {
-        let (ra, rb) = (self.find(a), self.find(b));
-        if ra == rb {
-            return false;
+    /// The representative of `x`'s set (iterative, with path halving: no
+    /// recursion however deep the chain of parents).
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.parent[x] != x {
+            let g = self.parent[self.parent[x]];
+            self.parent[x] = g;
+            x = g;
         }
-        self.parent.insert(ra, rb);
-        true
+        x
+    }
+
+    /// Joins the sets of `a` and `b` (not joined yet).
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        self.parent[ra] = rb;
     }
 }

@@ -11,7 +11,9 @@
 //! - `simulation` — `name`, `[simulation]`, `[output]`;
 //! - `scheme` — `[scheme]` (with `scheme.law`, the printed law's warning);
 //!   `leader` — `[leader]`; `agents` — `[[agent]]`;
-//! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check);
+//! - `ids` — agent ids and their ranks (per-agent data is kept by rank);
+//! - `graph` — `[[edge]]`, `[[leader_link]]` (the forest check), the
+//!   adjacency by rank;
 //! - `checks` — reachability from the leader, spectrum (sparse: extremes
 //!   and count; every eigenvalue only for small N), Appendix D;
 //! - `network` — `[network]`, `[[network.link]]`;
@@ -26,6 +28,7 @@ mod checks;
 mod ctx;
 mod graph;
 mod guard;
+mod ids;
 mod leader;
 mod network;
 mod rotation;
@@ -33,12 +36,13 @@ mod scheme;
 mod simulation;
 mod stiffness;
 
+pub use ctx::MAX_STEPS;
 pub use stiffness::{REFUSE_FACTOR, WARN_FROM, stable_dt};
 
-use super::schema::{Scenario, SchemeKind};
+use super::schema::{Output, Scenario, SchemeKind, Simulation};
 use crate::options::StiffnessCheck;
-use attitude::network::Network;
-use attitude::stiffness::Estimate;
+use attitude::network::{Network, Scheme};
+use attitude::stiffness::{Estimate, Interval};
 use ctx::Ctx;
 use std::collections::BTreeMap;
 use std::fmt;
@@ -101,13 +105,15 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     let law = scheme::law(&mut c, &s.scheme);
     let leader = leader::leader(&mut c, &s.leader, kind);
     let ids = agents::ids(&mut c, &s.agents);
-    let bodies = agents::bodies(&mut c, &s.agents, kind);
+    let bodies = agents::bodies(&mut c, &s.agents, kind, &ids);
     let edges = graph::edges(&mut c, &s.edges, &ids);
     let links = graph::leader_links(&mut c, &s.leader_links, &ids);
-    checks::reachability(&mut c, &ids, &edges, &links, !s.leader_links.is_empty());
-    let spectrum = checks::spectrum(&mut c, &ids, &edges, &links, scheme.as_ref(), &leader.p);
+    let ranked = edges.ranks(&ids);
+    let adjacency = graph::Adjacency::new(ids.len(), &ranked);
+    checks::reachability(&mut c, &ids, &adjacency, &links, !s.leader_links.is_empty());
+    let spectrum = checks::spectrum(&mut c, &ranked, &links, scheme.as_ref(), &leader.p);
     let impaired = if time.dt > 0.0 && time.dt.is_finite() {
-        network::network(&mut c, &s.network, time.dt, &edges, &links)
+        network::network(&mut c, &s.network, time.dt, &edges, &links, &ids)
     } else {
         BTreeMap::new()
     };
@@ -124,22 +130,28 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         guard: envelope,
         law,
     };
-    let network = assemble::network(parts, &edges, &links);
+    let wiring = assemble::Graph {
+        ids: &ids,
+        edges: &edges,
+        adjacency: &adjacency,
+        links: &links,
+    };
+    let network = assemble::network(parts, &wiring);
     // The extremes of Ξ + LLᵀ are all the estimate needs (none without agents).
     let extremes = [spectrum.lambda_min, spectrum.lambda_max];
-    let graph = if network.agents.is_empty() {
+    let ends = if network.agents.is_empty() {
         &[][..]
     } else {
         &extremes[..]
     };
-    let estimate = stiffness::stiffness(&mut c, &network, graph, check);
+    let estimate = stiffness::stiffness(&mut c, &network, ends, check);
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
     Ok(Resolved {
         network,
         warnings: c.warnings,
-        leader_links: links.gain.keys().copied().collect(),
+        leader_links: links.linked().map(|r| ids.id(r)).collect(),
         edges: edges.pairs,
         spectrum: spectrum.eigenvalues,
         spectrum_extremes: (spectrum.lambda_min, spectrum.lambda_max),
@@ -147,6 +159,26 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         stiffness: estimate,
         plugins: Vec::new(),
     })
+}
+
+/// The problems `[simulation]` and `[output]` alone have (the first phase
+/// of [`resolve`]): a step, horizon, period or sample period `check` refuses.
+#[must_use]
+pub fn timing_issues(sim: &Simulation, out: &Output) -> Vec<Issue> {
+    let mut c = Ctx::default();
+    simulation::simulation(&mut c, sim, out);
+    c.errors
+}
+
+/// The stiffness estimate of `r`'s network under `scheme` (the network's
+/// own scheme with other gains, say), as [`resolve`] would give it for the
+/// scenario with those gains; `None` without agents.
+#[must_use]
+pub fn stiffness_with(r: &Resolved, scheme: Scheme) -> Option<Estimate> {
+    let (min, max) = r.spectrum_extremes;
+    let graph = Interval { min, max };
+    let loops = stiffness::loops(&r.network, scheme, graph)?;
+    Some(attitude::stiffness::estimate(&loops))
 }
 
 impl Resolved {

@@ -3,6 +3,7 @@
 
 use super::ctx::Ctx;
 use super::graph::{Edges, LeaderLinks};
+use super::ids::Ids;
 use crate::scenario::schema::{LossSpec, NetworkSpec};
 use attitude::link::{LinkModel, Loss, link_seed};
 use std::collections::{BTreeMap, BTreeSet};
@@ -14,15 +15,8 @@ pub(super) fn network(
     dt: f64,
     edges: &Edges,
     links: &LeaderLinks,
+    ids: &Ids,
 ) -> BTreeMap<(u32, u32), LinkModel> {
-    let mut directed: BTreeSet<(u32, u32)> = BTreeSet::new();
-    for &(a, b) in &edges.pairs {
-        directed.insert((a, b));
-        directed.insert((b, a));
-    }
-    for &a in links.seen.keys() {
-        directed.insert((0, a));
-    }
     let defaults = Impairments::read(
         c,
         "network",
@@ -32,21 +26,22 @@ pub(super) fn network(
         net.period,
         dt,
     );
+    if net.links.is_empty() && !defaults.model(None, 0).is_impaired() {
+        return BTreeMap::new(); // no link has an impairment: none to list
+    }
+    let mut directed: BTreeSet<(u32, u32)> = BTreeSet::new();
+    for &(a, b) in &edges.pairs {
+        directed.insert((a, b));
+        directed.insert((b, a));
+    }
+    for r in links.linked() {
+        directed.insert((0, ids.id(r)));
+    }
     let overrides = overrides(c, net, dt, &directed);
     let mut out = BTreeMap::new();
     for &(from, to) in &directed {
         let o = overrides.get(&(from, to)).map(|(_, i)| i);
-        let pick = |f: fn(&Impairments) -> Option<u64>| o.and_then(f).or_else(|| f(&defaults));
-        let model = LinkModel {
-            delay: pick(|i| i.delay).unwrap_or(0),
-            jitter: pick(|i| i.jitter).unwrap_or(0),
-            loss: o
-                .and_then(|i| i.loss)
-                .or(defaults.loss)
-                .unwrap_or(Loss::None),
-            period: pick(|i| i.period),
-            seed: link_seed(net.seed, from, to),
-        };
+        let model = defaults.model(o, link_seed(net.seed, from, to));
         if model.is_impaired() {
             out.insert((from, to), model);
         }
@@ -96,6 +91,18 @@ struct Impairments {
 }
 
 impl Impairments {
+    /// The link model of these defaults with the override `o`, if any.
+    fn model(&self, o: Option<&Impairments>, seed: u64) -> LinkModel {
+        let pick = |f: fn(&Impairments) -> Option<u64>| o.and_then(f).or_else(|| f(self));
+        LinkModel {
+            delay: pick(|i| i.delay).unwrap_or(0),
+            jitter: pick(|i| i.jitter).unwrap_or(0),
+            loss: o.and_then(|i| i.loss).or(self.loss).unwrap_or(Loss::None),
+            period: pick(|i| i.period),
+            seed,
+        }
+    }
+
     fn read(
         c: &mut Ctx,
         f: &str,

@@ -19,8 +19,8 @@ impl Ctx {
             r.angle_deg.map(|a| ("angle_deg", a.to_radians())),
             r.angle_pi.map(|a| ("angle_pi", a * std::f64::consts::PI)),
         ];
-        let angles: Vec<_> = angles.into_iter().flatten().collect();
-        let forms = usize::from(r.axis.is_some() || !angles.is_empty())
+        let given = angles.iter().flatten().count();
+        let forms = usize::from(r.axis.is_some() || given > 0)
             + usize::from(r.quaternion.is_some())
             + usize::from(r.matrix.is_some());
         if forms != 1 {
@@ -78,25 +78,25 @@ impl Ctx {
         Some(m)
     }
 
-    /// `axis` with exactly one of the `angles` (name, radians).
+    /// `axis` with exactly one of the `angles` given (name, radians).
     fn rotation_axis_angle(
         &mut self,
         field: impl Display + Copy,
         axis: Option<[f64; 3]>,
-        angles: &[(&str, f64)],
+        angles: &[Option<(&str, f64)>; 3],
     ) -> Option<Matrix3<f64>> {
         let Some(axis) = axis else {
             self.err(format!("{field}.axis"), "an angle needs an axis");
             return None;
         };
-        if angles.len() != 1 {
+        let mut given = angles.iter().flatten();
+        let (Some(&(name, angle)), None) = (given.next(), given.next()) else {
             self.err(
                 field.to_string(),
                 "give exactly one of angle_rad, angle_deg, angle_pi",
             );
             return None;
-        }
-        let (name, angle) = angles[0];
+        };
         if !self.finite(format_args!("{field}.{name}"), angle) {
             return None;
         }

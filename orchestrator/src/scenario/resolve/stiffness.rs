@@ -39,11 +39,11 @@ pub(super) fn graph_extremes(spectrum: &[f64]) -> Option<Interval> {
     })
 }
 
-/// The loops of `net`'s scheme with what their linearisations need, or
-/// `None` for a network without agents.
-pub(super) fn loops(net: &Network, graph: Interval) -> Option<Vec<Loop>> {
+/// The loops of `scheme` (`net`'s own, or the same with other gains) with
+/// what their linearisations need from `net`, or `None` for a network
+/// without agents.
+pub(super) fn loops(net: &Network, scheme: Scheme, graph: Interval) -> Option<Vec<Loop>> {
     let models: Vec<&AgentModel> = net.agents.iter().map(|a| &a.model).collect();
-    let scheme = models.first()?.scheme;
     let coupling = eig_interval(models.iter().flat_map(|m| {
         m.neighbours
             .iter()
@@ -112,7 +112,8 @@ pub(super) fn stiffness(
     spectrum: &[f64],
     check: StiffnessCheck,
 ) -> Option<Estimate> {
-    let est = estimate(&loops(net, graph_extremes(spectrum)?)?);
+    let scheme = net.agents.first()?.model.scheme;
+    let est = estimate(&loops(net, scheme, graph_extremes(spectrum)?)?);
     let Some(b) = est.binding().filter(|b| b.dt_max.is_finite()) else {
         return Some(est);
     };
