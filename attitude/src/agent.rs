@@ -13,12 +13,14 @@
 
 use crate::body::omega_dot;
 use crate::control::{tau_districontrol, tracking_error};
-use crate::integrate::{LieDerivative, LieState, Rkmk4};
+use crate::guard::{self, Envelope, Violation};
+use crate::integrate::{LieDerivative, LieState, Stages, Start};
 use crate::link::{Link, LinkModel, LinkStats};
 use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
 use crate::observer::{
     LeaderInput, omega_hat_dot_7b, omega_hat_dot_16b, r_hat_rate, sigma_hat_dot_7c,
 };
+use crate::verdict::Verdicts;
 use nalgebra::{Matrix3, Vector3};
 
 /// The closed-loop vector field of agent i and the torque it applies.
@@ -103,10 +105,12 @@ pub fn exchanged_of(scheme: &Scheme, x: &AgentState) -> Exchanged {
     }
 }
 
-fn to_lie(x: &AgentState) -> LieState<2, 3> {
-    LieState {
-        rot: [x.r, x.r_hat],
-        vec: [x.w, x.w_hat, x.s_hat],
+/// `x` as the start of an RKMK4 step (by reference: the agent keeps its
+/// state once).
+fn start(x: &AgentState) -> Start<'_, 2, 3> {
+    Start {
+        rot: [&x.r, &x.r_hat],
+        vec: [&x.w, &x.w_hat, &x.s_hat],
     }
 }
 
@@ -125,14 +129,17 @@ fn from_lie(y: &LieState<2, 3>) -> AgentState {
 pub struct Agent {
     model: AgentModel,
     gains: Vec<Matrix3<f64>>,
+    /// State at the start of the current step (RKMK4's `y₀`).
     state: AgentState,
-    step: Rkmk4<2, 3>,
+    step: Stages<2, 3>,
     /// `step`'s current stage state, computed once per stage (published
     /// and evaluated at).
     stage_x: AgentState,
     dt: f64,
     held_nbrs: Vec<Exchanged>,
-    held_leader: Option<Exchanged>,
+    /// The leader's value, for an agent that hears it (boxed: most agents
+    /// do not, and the agents' data is swept at every stage).
+    held_leader: Option<Box<Exchanged>>,
     /// Impaired links, per input (neighbours, then the leader), boxed so
     /// that an agent without any (the common case) steps over a few
     /// pointers, not over whole links, at every stage.
@@ -142,6 +149,8 @@ pub struct Agent {
     /// Current step index.
     n: u64,
     peak_torque: f64,
+    /// What proves the verdicts of this step's published values.
+    verdicts: Verdicts,
 }
 
 impl Agent {
@@ -150,7 +159,7 @@ impl Agent {
     pub fn new(model: AgentModel, initial: AgentState, dt: f64) -> Self {
         let gains = model.neighbours.iter().map(|n| n.a).collect();
         let held_nbrs = vec![Exchanged::identity(); model.neighbours.len()];
-        let held_leader = model.leader_gain.map(|_| Exchanged::identity());
+        let held_leader = model.leader_gain.map(|_| Box::new(Exchanged::identity()));
         let impaired = |l: &Option<LinkModel>| {
             l.filter(LinkModel::is_impaired)
                 .map(|m| Box::new(Link::new(m)))
@@ -166,7 +175,7 @@ impl Agent {
             gains,
             rejected,
             state: initial,
-            step: Rkmk4::new(to_lie(&initial), dt),
+            step: Stages::new(&[initial.w, initial.w_hat, initial.s_hat], dt),
             stage_x: initial,
             dt,
             held_nbrs,
@@ -174,6 +183,7 @@ impl Agent {
             links,
             n: 0,
             peak_torque: 0.0,
+            verdicts: Verdicts::default(),
         }
     }
 
@@ -201,6 +211,42 @@ impl Agent {
         exchanged_of(&self.model.scheme, &self.stage_x)
     }
 
+    /// The guard's check of the state at the start of the current step
+    /// ([`guard::check_agent`]). A state inside the envelope also settles
+    /// the verdict on the step's stage-0 value ([`Verdicts::checked`]).
+    pub fn check(&mut self, env: &Envelope) -> Option<Violation> {
+        match guard::check_agent_defects(&self.state, env) {
+            Ok(defects) => {
+                if self.step.stage() == 0 {
+                    let published = usize::from(self.model.scheme.has_observer());
+                    self.verdicts.checked(self.n, defects[published]);
+                }
+                None
+            }
+            Err(v) => Some(v),
+        }
+    }
+
+    /// [`Self::stage_exchange`] and whether a receiver may use it: always
+    /// `x.trust().is_ok()`, proven instead of checked where it can be
+    /// ([`crate::verdict`]; an engine that hands one value to many
+    /// receivers judges it once, here).
+    pub fn stage_exchange_judged(&mut self) -> (Exchanged, bool) {
+        let mut x = Exchanged::identity();
+        let trusted = self.publish_into(&mut x);
+        (x, trusted)
+    }
+
+    /// [`Self::stage_exchange_judged`] written where it is published:
+    /// the value into `out`, the verdict returned.
+    #[inline]
+    pub(crate) fn publish_into(&mut self, out: &mut Exchanged) -> bool {
+        *out = self.stage_exchange();
+        let published = usize::from(self.model.scheme.has_observer());
+        let u = &self.step.increments()[published];
+        (self.verdicts).judge(out, self.n, self.step.stage(), u)
+    }
+
     /// Stores the value received from the `k`-th neighbour (order of `model.neighbours`).
     /// On an impaired link the message goes through the link's filter (see [`crate::link`]).
     /// An untrusted value ([`Exchanged::trust`]) is refused and counted; the
@@ -213,13 +259,20 @@ impl Agent {
     /// already evaluated (once per sender, by an engine that hands one
     /// value to many receivers).
     pub fn receive_neighbour_judged(&mut self, k: usize, x: Exchanged, trusted: bool) {
+        self.hold_neighbour(k, &x, trusted);
+    }
+
+    /// [`Self::receive_neighbour_judged`] from where the value lies (one
+    /// copy, into the held value).
+    #[inline]
+    pub(crate) fn hold_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool) {
         if !trusted {
             self.rejected[k] += 1;
             return;
         }
         match &mut self.links[k] {
-            Some(link) => link.offer(self.n, self.step.stage() as u32, x),
-            None => self.held_nbrs[k] = x,
+            Some(link) => link.offer(self.n, self.step.stage() as u32, *x),
+            None => self.held_nbrs[k] = *x,
         }
     }
 
@@ -241,7 +294,7 @@ impl Agent {
         let stage = self.step.stage() as u32;
         match (&mut self.held_leader, self.links.get_mut(k)) {
             (Some(_), Some(Some(link))) => link.offer(self.n, stage, x),
-            (Some(h), _) => *h = x,
+            (Some(h), _) => **h = x,
             (None, _) => {}
         }
     }
@@ -278,7 +331,7 @@ impl Agent {
                 if k < n_nbrs {
                     self.held_nbrs[k] = x;
                 } else if let Some(h) = &mut self.held_leader {
-                    *h = x;
+                    **h = x;
                 }
             }
         }
@@ -287,21 +340,21 @@ impl Agent {
             &self.gains,
             &self.stage_x,
             &self.held_nbrs,
-            self.held_leader.as_ref(),
+            self.held_leader.as_deref(),
         );
         if stage == 0 {
             self.peak_torque = self.peak_torque.max(tau.norm());
         }
-        match self.step.push_derivative(&d) {
+        match self.step.push_derivative(start(&self.state), &d) {
             Some(next) => {
                 self.state = from_lie(&next);
-                self.step = Rkmk4::new(next, self.dt);
+                self.step.restart(&next.vec);
                 self.stage_x = self.state;
                 self.n += 1;
                 true
             }
             None => {
-                self.stage_x = from_lie(&self.step.stage_state());
+                self.stage_x = from_lie(&self.step.stage_state(start(&self.state)));
                 false
             }
         }

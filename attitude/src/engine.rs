@@ -7,6 +7,9 @@
 //! each thread steps a contiguous chunk of the agents and the exchanges are
 //! barriers; an agent's arithmetic depends only on its own state and the
 //! values it holds, so the results are bit-identical for any thread count.
+//! At an output sample [`InProcess::run_with`] has each thread also do a
+//! caller's per-agent work for its own agents (recording's rows), so the
+//! serial part of a sample is only what cannot be shared (writing files).
 //!
 //! # Layout
 //! - `pass`: one stage over a run of agents (receive, advance, publish, check).
@@ -177,8 +180,11 @@ impl InProcess {
                 &mut self.agents,
                 &self.nbr_index,
                 stage,
-                |j| read[j],
-                |k, x| out[k] = x,
+                |j| &read[j],
+                |k, a| {
+                    let Judged(x, trusted) = &mut out[k];
+                    *trusted = a.publish_into(x);
+                },
             );
             if slot.exchange {
                 self.published.swap(0, 1);
@@ -195,8 +201,9 @@ impl InProcess {
     /// exchange `slot`, unless the last pass did.
     fn publish_if_needed(&mut self, slot: Slot) {
         if self.ready != Some((slot.step, slot.stage)) {
-            for (p, a) in self.published[0].iter_mut().zip(&self.agents) {
-                *p = Judged::of(a.stage_exchange());
+            for (p, a) in self.published[0].iter_mut().zip(&mut self.agents) {
+                let (x, trusted) = a.stage_exchange_judged();
+                *p = Judged(x, trusted);
             }
         }
     }
@@ -215,12 +222,20 @@ impl InProcess {
         (self.sampled.0, &self.sampled.1)
     }
 
-    /// Books the current step as sampled, then hands its snapshot to `f`.
-    fn sample(&mut self, f: &mut impl FnMut(&Snapshot<'_>) -> bool) -> bool {
+    /// Books the current step as sampled, does `work` for every agent
+    /// into `outs`, then hands the snapshot and `outs` to `f`.
+    fn sample<T>(
+        &mut self,
+        (work, outs): Work<'_, T, impl PerAgent<T>>,
+        f: &mut impl OnSample<T>,
+    ) -> bool {
         self.sampled.0 = self.step;
         self.sampled.1.clear();
         (self.sampled.1).extend(self.agents.iter().map(Agent::peak_torque));
-        f(&self.snapshot())
+        outs.clear();
+        let leader = self.leader.state();
+        outs.extend((self.states.iter().enumerate()).map(|(k, x)| work(k, x, leader)));
+        f(&self.snapshot(), outs.as_slice())
     }
 
     /// The first node (the leader, then agents in network order) whose
@@ -236,17 +251,31 @@ impl InProcess {
     /// then it returns the divergence. The state is checked at t = 0 and
     /// after every step.
     pub fn run(&mut self, mut on_sample: impl FnMut(&Snapshot<'_>) -> bool) -> Option<Divergence> {
+        self.run_with(|_, _, _| (), |snap, _| on_sample(snap))
+    }
+
+    /// [`Self::run`], and at every sample `work(k, state, leader)` for
+    /// every agent `k` (network order), done by the thread that steps the
+    /// agent — in parallel on several threads — and handed to `on_sample`
+    /// beside the snapshot, in network order: the per-agent part of
+    /// recording a sample, out of the serial part.
+    pub fn run_with<T: Send>(
+        &mut self,
+        work: impl PerAgent<T> + Sync,
+        mut on_sample: impl OnSample<T>,
+    ) -> Option<Divergence> {
+        let mut outs = Vec::new();
         if self.step == 0 {
             if let Some(d) = self.divergence() {
                 return Some(d);
             }
-            if !self.sample(&mut on_sample) {
+            if !self.sample((&work, &mut outs), &mut on_sample) {
                 return None;
             }
         }
         if self.threads > 1 && self.step < self.net.steps {
             self.ready = None;
-            let diverged = self.run_parallel(on_sample);
+            let diverged = self.run_parallel((&work, &mut outs), on_sample);
             self.refresh_states();
             return diverged;
         }
@@ -258,7 +287,7 @@ impl InProcess {
             }
             if sample_due(&self.net, self.step) {
                 self.refresh_states();
-                if !self.sample(&mut on_sample) {
+                if !self.sample((&work, &mut outs), &mut on_sample) {
                     return None;
                 }
             }
@@ -266,12 +295,13 @@ impl InProcess {
         None
     }
 
-    /// [`Self::run`] on `self.threads` threads: the calling thread steps
-    /// the leader and the first share and samples; a worker steps each
-    /// other share (see `crew`).
-    fn run_parallel(
+    /// [`Self::run_with`] on `self.threads` threads: the calling thread
+    /// steps the leader and the first share and samples; a worker steps
+    /// each other share (see `crew`).
+    fn run_parallel<T: Send>(
         &mut self,
-        mut on_sample: impl FnMut(&Snapshot<'_>) -> bool,
+        (work, all): Work<'_, T, impl PerAgent<T> + Sync>,
+        mut on_sample: impl OnSample<T>,
     ) -> Option<Divergence> {
         let Self {
             net,
@@ -291,35 +321,40 @@ impl InProcess {
             sample_every: net.sample_every,
             guard: &net.guard,
         };
-        let from = *step;
+        let (from, outs) = (*step, crew::outputs::<T>(*threads));
         std::thread::scope(|scope| {
             let mut shares = Share::split(agents, *threads).into_iter();
             let mut mine = shares.next().expect("at least one share");
-            for share in shares {
+            for (share, out) in shares.zip(&outs[1..]) {
                 let board = &board;
-                scope.spawn(move || crew::work(share, board, plan, from));
+                scope.spawn(move || crew::work(share, board, plan, from, (work, out)));
             }
             while *step < net.steps {
                 mine.step(&board, plan, *step, Some(leader));
                 *step += 1;
+                let due = plan.sample_due(*step);
+                if due {
+                    crew::read_states(&board, states);
+                    let now = (leader.state(), &states[..]);
+                    crew::gather(&mine, &board, (work, &outs), now, all);
+                }
                 let found = crew::read_found(&board);
                 if let Some(d) = divergence_at(net, *step, leader.state(), found) {
                     crew::release(&board, false);
                     return Some(d);
                 }
-                if !plan.sample_due(*step) {
+                if !due {
                     crew::release(&board, true);
                     continue;
                 }
                 sampled.0 = *step;
                 crew::read_peaks(&board, &mut sampled.1);
-                crew::read_states(&board, states);
                 let snapshot = Snapshot {
                     step: *step,
                     leader: leader.state(),
                     agents: states,
                 };
-                let go_on = on_sample(&snapshot);
+                let go_on = on_sample(&snapshot, all.as_slice());
                 crew::release(&board, go_on);
                 if !go_on {
                     return None;
@@ -329,6 +364,21 @@ impl InProcess {
         })
     }
 }
+
+/// Per-agent work at a sample ([`InProcess::run_with`]): agent index
+/// (network order), its state, the leader's state.
+pub trait PerAgent<T>: Fn(usize, &AgentState, &LeaderState) -> T {}
+
+impl<T, F: Fn(usize, &AgentState, &LeaderState) -> T> PerAgent<T> for F {}
+
+/// What [`InProcess::run_with`] calls at a sample: the snapshot and every
+/// agent's work, in network order; `false` stops the run.
+pub trait OnSample<T>: FnMut(&Snapshot<'_>, &[T]) -> bool {}
+
+impl<T, F: FnMut(&Snapshot<'_>, &[T]) -> bool> OnSample<T> for F {}
+
+/// The per-agent work and where its results go.
+type Work<'a, T, W> = (&'a W, &'a mut Vec<T>);
 
 /// The divergence of the network at `step`: the leader's state if it is
 /// outside the envelope, else the first agent `found` outside it (index in

@@ -165,14 +165,22 @@ impl Violation {
 /// An attitude's violation: a non-finite entry, or not a rotation to
 /// [`ROTATION_TOLERANCE`] (as a received state is checked).
 fn attitude(quantity: Quantity, r: &Matrix3<f64>) -> Option<Violation> {
+    attitude_defect(quantity, r).err()
+}
+
+/// [`attitude`], and for a rotation its orthogonality defect.
+fn attitude_defect(quantity: Quantity, r: &Matrix3<f64>) -> Result<f64, Violation> {
     if let Some(&value) = r.iter().find(|v| !v.is_finite()) {
-        return Some(Violation { quantity, value });
+        return Err(Violation { quantity, value });
     }
     let defect = crate::so3::orthogonality_defect(r);
-    (defect > ROTATION_TOLERANCE || r.determinant() <= 0.0).then_some(Violation {
-        quantity,
-        value: defect,
-    })
+    if defect > ROTATION_TOLERANCE || r.determinant() <= 0.0 {
+        return Err(Violation {
+            quantity,
+            value: defect,
+        });
+    }
+    Ok(defect)
 }
 
 /// A vector's violation: its norm not finite, or above `limit`.
@@ -185,11 +193,20 @@ fn vector(quantity: Quantity, v: &Vector3<f64>, limit: f64) -> Option<Violation>
 /// (`r, omega, r_hat, omega_hat, sigma_hat`).
 #[must_use]
 pub fn check_agent(x: &AgentState, env: &Envelope) -> Option<Violation> {
-    attitude(Quantity::R, &x.r)
-        .or_else(|| vector(Quantity::Omega, &x.w, env.omega))
-        .or_else(|| attitude(Quantity::RHat, &x.r_hat))
-        .or_else(|| vector(Quantity::OmegaHat, &x.w_hat, env.omega_hat))
-        .or_else(|| vector(Quantity::SigmaHat, &x.s_hat, env.sigma_hat))
+    check_agent_defects(x, env).err()
+}
+
+/// [`check_agent`], and for a state inside the envelope the orthogonality
+/// defects `‖RᵀR − I‖_F` of `r` and `r_hat` it computed (what
+/// [`crate::verdict`] proves the next published values' verdicts from).
+pub fn check_agent_defects(x: &AgentState, env: &Envelope) -> Result<[f64; 2], Violation> {
+    let within = |v: Option<Violation>| v.map_or(Ok(()), Err);
+    let r = attitude_defect(Quantity::R, &x.r)?;
+    within(vector(Quantity::Omega, &x.w, env.omega))?;
+    let r_hat = attitude_defect(Quantity::RHat, &x.r_hat)?;
+    within(vector(Quantity::OmegaHat, &x.w_hat, env.omega_hat))?;
+    within(vector(Quantity::SigmaHat, &x.s_hat, env.sigma_hat))?;
+    Ok([r, r_hat])
 }
 
 /// The first violation of the leader's state (`r0, omega0, sigma0`).

@@ -63,6 +63,68 @@ const A: [f64; 3] = [0.5, 0.5, 1.0];
 #[derive(Debug, Clone)]
 pub struct Rkmk4<const NR: usize, const NV: usize> {
     y0: LieState<NR, NV>,
+    stages: Stages<NR, NV>,
+}
+
+impl<const NR: usize, const NV: usize> Rkmk4<NR, NV> {
+    /// Starts a step of size `h` from `y0`.
+    #[must_use]
+    pub fn new(y0: LieState<NR, NV>, h: f64) -> Self {
+        let stages = Stages::new(&y0.vec, h);
+        Self { y0, stages }
+    }
+
+    /// Index of the stage whose derivative is expected next (0..4).
+    #[must_use]
+    pub fn stage(&self) -> usize {
+        self.stages.stage()
+    }
+
+    /// The state at which the current stage's vector field is evaluated.
+    #[must_use]
+    pub fn stage_state(&self) -> LieState<NR, NV> {
+        self.stages.stage_state(Start::of(&self.y0))
+    }
+
+    /// Hands in the vector field at [`Self::stage_state`]. Returns the new
+    /// state after the fourth stage, `None` before.
+    pub fn push_derivative(&mut self, k: &LieDerivative<NR, NV>) -> Option<LieState<NR, NV>> {
+        self.stages.push_derivative(Start::of(&self.y0), k)
+    }
+}
+
+/// A step's start state `y₀`, by reference (its owner may keep it in any layout).
+#[derive(Debug, Clone, Copy)]
+pub struct Start<'a, const NR: usize, const NV: usize> {
+    /// Rotations.
+    pub rot: [&'a Matrix3<f64>; NR],
+    /// Vectors.
+    pub vec: [&'a Vector3<f64>; NV],
+}
+
+impl<'a, const NR: usize, const NV: usize> Start<'a, NR, NV> {
+    /// The parts of `y`.
+    #[must_use]
+    pub fn of(y: &'a LieState<NR, NV>) -> Self {
+        Self {
+            rot: std::array::from_fn(|i| &y.rot[i]),
+            vec: std::array::from_fn(|i| &y.vec[i]),
+        }
+    }
+
+    fn owned(&self) -> LieState<NR, NV> {
+        LieState {
+            rot: self.rot.map(|r| *r),
+            vec: self.vec.map(|v| *v),
+        }
+    }
+}
+
+/// An RKMK4 step in progress without its start state, which the caller
+/// keeps and hands in ([`Start`]) — what [`Rkmk4`] is made of; a node that
+/// keeps its state anyway (an agent) keeps it once.
+#[derive(Debug, Clone)]
+pub struct Stages<const NR: usize, const NV: usize> {
     h: f64,
     stage: usize,
     /// Lie-algebra increments `uₛ` of the current stage (one per rotation).
@@ -75,19 +137,28 @@ pub struct Rkmk4<const NR: usize, const NV: usize> {
     x: [Vector3<f64>; NV],
 }
 
-impl<const NR: usize, const NV: usize> Rkmk4<NR, NV> {
-    /// Starts a step of size `h` from `y0`.
+impl<const NR: usize, const NV: usize> Stages<NR, NV> {
+    /// Starts a step of size `h` from a state whose vectors are `vec`.
     #[must_use]
-    pub fn new(y0: LieState<NR, NV>, h: f64) -> Self {
+    pub fn new(vec: &[Vector3<f64>; NV], h: f64) -> Self {
         Self {
-            y0,
             h,
             stage: 0,
             u: [Vector3::zeros(); NR],
             sum_u: [Vector3::zeros(); NR],
             sum_k: [Vector3::zeros(); NV],
-            x: y0.vec,
+            x: *vec,
         }
+    }
+
+    /// Starts the next step, of the same size, from a state whose vectors
+    /// are `vec` (in place: [`Self::new`] without building a new one).
+    pub fn restart(&mut self, vec: &[Vector3<f64>; NV]) {
+        self.stage = 0;
+        self.u = [Vector3::zeros(); NR];
+        self.sum_u = [Vector3::zeros(); NR];
+        self.sum_k = [Vector3::zeros(); NV];
+        self.x = *vec;
     }
 
     /// Index of the stage whose derivative is expected next (0..4).
@@ -96,22 +167,35 @@ impl<const NR: usize, const NV: usize> Rkmk4<NR, NV> {
         self.stage
     }
 
-    /// The state at which the current stage's vector field is evaluated.
+    /// The Lie-algebra increments `u` of the current stage, one per
+    /// rotation: the stage point's rotations are `R₀ exp(u)` (zero at stage 0).
     #[must_use]
-    pub fn stage_state(&self) -> LieState<NR, NV> {
+    pub fn increments(&self) -> &[Vector3<f64>; NR] {
+        &self.u
+    }
+
+    /// The state at which the current stage's vector field is evaluated,
+    /// for a step that started at `y0`.
+    #[must_use]
+    pub fn stage_state(&self, y0: Start<'_, NR, NV>) -> LieState<NR, NV> {
         if self.stage == 0 {
-            return self.y0;
+            return y0.owned();
         }
-        let mut rot = self.y0.rot;
+        let mut rot = y0.rot.map(|r| *r);
         for (r, u) in rot.iter_mut().zip(&self.u) {
             *r *= exp(u);
         }
         LieState { rot, vec: self.x }
     }
 
-    /// Hands in the vector field at [`Self::stage_state`]. Returns the new
-    /// state after the fourth stage, `None` before.
-    pub fn push_derivative(&mut self, k: &LieDerivative<NR, NV>) -> Option<LieState<NR, NV>> {
+    /// Hands in the vector field at [`Self::stage_state`] of a step that
+    /// started at `y0`. Returns the new state after the fourth stage,
+    /// `None` before.
+    pub fn push_derivative(
+        &mut self,
+        y0: Start<'_, NR, NV>,
+        k: &LieDerivative<NR, NV>,
+    ) -> Option<LieState<NR, NV>> {
         let s = self.stage;
         assert!(s < 4, "RKMK4 step already complete");
         let weight = if s == 0 || s == 3 { 1.0 } else { 2.0 };
@@ -125,7 +209,7 @@ impl<const NR: usize, const NV: usize> Rkmk4<NR, NV> {
         for i in 0..NV {
             self.sum_k[i] += k.vec[i] * weight;
             if s < 3 {
-                self.x[i] = self.y0.vec[i] + k.vec[i] * (self.h * A[s]);
+                self.x[i] = y0.vec[i] + k.vec[i] * (self.h * A[s]);
             }
         }
         self.stage += 1;
@@ -133,14 +217,9 @@ impl<const NR: usize, const NV: usize> Rkmk4<NR, NV> {
             return None;
         }
         let h6 = self.h / 6.0;
-        let mut y = self.y0;
-        for i in 0..NR {
-            y.rot[i] = self.y0.rot[i] * exp(&(self.sum_u[i] * h6));
-        }
-        for i in 0..NV {
-            y.vec[i] = self.y0.vec[i] + self.sum_k[i] * h6;
-        }
-        Some(y)
+        let rot = std::array::from_fn(|i| y0.rot[i] * exp(&(self.sum_u[i] * h6)));
+        let vec = std::array::from_fn(|i| y0.vec[i] + self.sum_k[i] * h6);
+        Some(LieState { rot, vec })
     }
 }
 

@@ -19,6 +19,7 @@
 //! - [`network`]: the resolved network every engine runs.
 //! - [`link`]: delay, jitter, loss and per-link period, on the receiving side.
 //! - [`agent`]: one follower as a stage-by-stage stepper (the exchange protocol).
+//! - [`verdict`]: the verdict on a follower's own published values, proven within a step.
 //! - [`schedule`]: the stages `(n, s)` of a run and which are exchanges (every loop walks it).
 //! - [`engine`]: all nodes in one process, in lockstep.
 //! - [`guard`]: the envelope of a sane state; divergence as a typed failure.
@@ -45,3 +46,4 @@ pub mod so3;
 pub mod sparse;
 pub mod spectrum;
 pub mod stiffness;
+pub mod verdict;

@@ -45,9 +45,13 @@ impl Exchanged {
     /// keeps what it had), so they stay bit-identical even when a run
     /// diverges.
     pub fn trust(&self) -> Result<(), Untrusted> {
-        // v·0 is ±0 for a finite v and NaN for a NaN or an infinity: the sum
-        // is 0 iff every value is finite (branch-free, the verdict of `is_finite`).
-        let finite = |xs: &[f64]| xs.iter().map(|v| v * 0.0).sum::<f64>() == 0.0;
+        self.trusted_defect().map(|_| ())
+    }
+
+    /// [`Self::trust`], and when trusted the attitude's orthogonality
+    /// defect `‖rᵀr − I‖_F` (what [`crate::verdict`] proves from).
+    pub fn trusted_defect(&self) -> Result<f64, Untrusted> {
+        let finite = Self::finite;
         if !(finite(self.r.as_slice()) && finite(self.w.as_slice()) && finite(self.s.as_slice())) {
             return Err(Untrusted::NonFinite);
         }
@@ -55,7 +59,14 @@ impl Exchanged {
         if defect > ROTATION_TOLERANCE || self.r.determinant() <= 0.0 {
             return Err(Untrusted::NotARotation(defect));
         }
-        Ok(())
+        Ok(defect)
+    }
+
+    /// Whether every value of `xs` is finite, as [`Self::trust`] decides it.
+    pub(crate) fn finite(xs: &[f64]) -> bool {
+        // v·0 is ±0 for a finite v and NaN for a NaN or an infinity: the sum
+        // is 0 iff every value is finite (branch-free, the verdict of `is_finite`).
+        xs.iter().map(|v| v * 0.0).sum::<f64>() == 0.0
     }
 }
 

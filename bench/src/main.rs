@@ -296,6 +296,9 @@ fn scale_table(
     } else {
         schemes
     };
+    let load = stats::loadavg();
+    let started = std::time::Instant::now();
+    let cpu = stats::cpu_seconds();
     let mut figures = Vec::new();
     for &s in schemes {
         for &n in agents.iter().filter(|&&n| n > 0) {
@@ -312,6 +315,15 @@ fn scale_table(
         }
     }
     print!("{}", scale::table(&figures, threads));
+    let cpu = cpu.zip(stats::cpu_seconds()).map(|(a, b)| b - a);
+    println!(
+        "\nWhole table: {:.0} s wall, {} CPU; load average (1, 5, 15 min) {} at the start, {} at the end.\n",
+        started.elapsed().as_secs_f64(),
+        cpu.map_or("–".into(), |c| format!("{c:.0} s")),
+        load,
+        stats::loadavg()
+    );
+    print!("{}", scale::conditions(&figures));
 }
 
 /// The arguments of `run` that become [`suite::Options`].

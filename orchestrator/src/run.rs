@@ -184,8 +184,9 @@ fn drive(
     let mut frames = opts.view.then(|| view::Collector::new(net));
     let bar = progress_bar(opts.progress, net.steps, net.dt);
     let mut write_error = None;
-    let mut record = |snap: &attitude::engine::Snapshot<'_>| {
-        if let Err(e) = recorder.record(snap) {
+    let row = recorder.row_maker();
+    let mut record = |snap: &attitude::engine::Snapshot<'_>, rows: &[results::Row]| {
+        if let Err(e) = recorder.record_rows(snap, rows) {
             write_error = Some(e);
             return false;
         }
@@ -201,15 +202,18 @@ fn drive(
             let mut engine = InProcess::new(net).with_threads(opts.threads);
             threads = Some(engine.threads());
             let mut interrupted = false;
-            let diverged = engine.run(|snap| {
+            // Each agent's row is made by the thread that steps it.
+            let diverged = engine.run_with(&row, |snap, rows| {
                 interrupted = interrupt.is_set();
-                !interrupted && record(snap)
+                !interrupted && record(snap, rows)
             });
             Outcome::in_process(&engine, interrupted, diverged)
         }
         Engine::Processes => {
             let mut process_opts = opts.processes.clone();
             process_opts.plugins = loaded.resolved.plugins.clone();
+            let record =
+                |snap: &attitude::engine::Snapshot<'_>| record(snap, &results::rows_of(&row, snap));
             processes::run(net, &process_opts, &layout.logs(), interrupt.flag(), record)?
         }
     };

@@ -6,6 +6,7 @@
 //! is the value written, bit for bit (NaN payloads included).
 
 use crate::network::{AgentState, Exchanged};
+use crate::reference::LeaderState;
 use nalgebra::{Matrix3, Vector3};
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
@@ -88,6 +89,21 @@ impl Words<EXCHANGED> for Exchanged {
             r: mat(w, 0),
             w: vec3(w, 9),
             s: vec3(w, 12),
+        }
+    }
+}
+
+impl Words<EXCHANGED> for LeaderState {
+    fn to_words(&self) -> [f64; EXCHANGED] {
+        self.exchanged().to_words()
+    }
+
+    fn from_words(w: &[f64; EXCHANGED]) -> Self {
+        let x = Exchanged::from_words(w);
+        Self {
+            r0: x.r,
+            w0: x.w,
+            s0: x.s,
         }
     }
 }

@@ -9,19 +9,22 @@
 //! buffer). Per step, two more: the step's end (each share's first agent
 //! outside the envelope, checked in its pass, and at a sample every
 //! agent's state and peak torque, on the board for the caller) and the
-//! go-ahead (the caller is done with them, or says stop).
+//! go-ahead (the caller is done with them, or says stop). At a sample with
+//! per-agent work ([`super::InProcess::run_with`]) one more: each thread
+//! does its share's work, then the caller takes every share's results.
 //!
 //! Every agent does exactly the arithmetic of the one-thread loop, on the
 //! same values in the same order, so the trajectories are bit-identical
 //! for any number of threads.
 
+use super::PerAgent;
 use super::barrier::SpinBarrier;
-use super::board::{AGENT_STATE, JUDGED, Judged, Slot as Shared, slots};
+use super::board::{AGENT_STATE, EXCHANGED, JUDGED, Judged, Slot as Shared, slots};
 use super::pass::{Stage, pass};
 use crate::agent::Agent;
 use crate::guard::{Envelope, Violation};
 use crate::network::AgentState;
-use crate::reference::Leader;
+use crate::reference::{Leader, LeaderState};
 use crate::schedule::{Schedule, Slot};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering::SeqCst};
@@ -36,6 +39,8 @@ pub(super) struct Board {
     states: Vec<Shared<AGENT_STATE>>,
     /// Every agent's peak torque at the end of the last sampled step.
     peaks: Vec<Shared<1>>,
+    /// The leader's state at the end of the last sampled step.
+    leader: Shared<EXCHANGED>,
     /// Per share, the first agent (network index) outside the envelope
     /// after the last step, if any.
     found: Vec<Mutex<Option<(usize, Violation)>>>,
@@ -50,6 +55,7 @@ impl Board {
             published: [slots(agents + 1), slots(agents + 1)],
             states: slots(agents),
             peaks: slots(agents),
+            leader: Shared::default(),
             found: (0..threads).map(|_| Mutex::new(None)).collect(),
             barrier: SpinBarrier::new(threads),
             stop: AtomicBool::new(false),
@@ -159,29 +165,46 @@ impl<'a> Share<'a> {
                 self.agents,
                 nbrs,
                 stage,
-                |j| read[j].load(),
-                |k, x| out[k].store(&x),
+                |j| read[j].load::<Judged>(),
+                |k, a| {
+                    let (x, trusted) = a.stage_exchange_judged();
+                    out[k].store(&Judged(x, trusted));
+                },
             );
             if let Some(x) = next {
                 self.ready = Some((x.step, x.stage));
             }
         }
-        self.leave(board, plan.sample_due(n + 1), found);
+        self.leave(board, plan.sample_due(n + 1), found, leader.as_deref());
         board.barrier.wait();
+    }
+
+    /// At a sample, `work` for each of this share's agents (network index,
+    /// state, the leader's state) into `out`, in order.
+    pub(super) fn outputs<T>(
+        &self,
+        work: &impl PerAgent<T>,
+        leader: &LeaderState,
+        out: &mut Vec<T>,
+    ) {
+        out.clear();
+        let states = self.agents.iter().map(Agent::state).enumerate();
+        out.extend(states.map(|(k, x)| work(self.first + k, x, leader)));
     }
 
     /// One exchange's meeting: publish (the leader's value, and this
     /// share's unless its last pass did), wait for everyone, then the
     /// leader's value as published.
-    fn exchange(&self, board: &Board, slot: Slot, leader: Option<&Leader>) -> Judged {
+    fn exchange(&mut self, board: &Board, slot: Slot, leader: Option<&Leader>) -> Judged {
         let buffer = &board.published[self.parity];
         let leader_slot = &buffer[buffer.len() - 1];
         if let Some(l) = leader {
             leader_slot.store(&Judged::of(l.stage_exchange()));
         }
         if self.ready != Some((slot.step, slot.stage)) {
-            for (cell, agent) in buffer[self.first..].iter().zip(self.agents.iter()) {
-                cell.store(&Judged::of(agent.stage_exchange()));
+            for (cell, agent) in buffer[self.first..].iter().zip(self.agents.iter_mut()) {
+                let (x, trusted) = agent.stage_exchange_judged();
+                cell.store(&Judged(x, trusted));
             }
         }
         board.barrier.wait();
@@ -190,12 +213,21 @@ impl<'a> Share<'a> {
 
     /// Leaves on the board, after a step, this share's first agent outside
     /// the envelope and, if the step is sampled, its states and peak torques.
-    fn leave(&self, board: &Board, sampled: bool, found: Option<(usize, Violation)>) {
+    fn leave(
+        &self,
+        board: &Board,
+        sampled: bool,
+        found: Option<(usize, Violation)>,
+        leader: Option<&Leader>,
+    ) {
         if let Some((k, v)) = found {
             *lock(&board.found[self.index]) = Some((self.first + k, v));
         }
         if !sampled {
             return;
+        }
+        if let Some(l) = leader {
+            board.leader.store(l.state());
         }
         for (slot, agent) in board.states[self.first..].iter().zip(self.agents.iter()) {
             slot.store(agent.state());
@@ -206,19 +238,64 @@ impl<'a> Share<'a> {
     }
 }
 
-fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+pub(super) fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
+/// One output list per share (the first unused: the caller gathers into its own).
+pub(super) fn outputs<T>(threads: usize) -> Vec<Mutex<Vec<T>>> {
+    (0..threads).map(|_| Mutex::new(Vec::new())).collect()
+}
+
+/// Whether a sample's per-agent work gives anything (for `()` the
+/// outputs and their barrier are skipped, on every thread alike).
+pub(super) fn has_outputs<T>() -> bool {
+    std::mem::size_of::<T>() != 0
+}
+
 /// A worker thread: steps its share from step `from` until the end or
-/// until the caller says stop.
-pub(super) fn work(mut share: Share<'_>, board: &Board, plan: Plan<'_>, from: u64) {
+/// until the caller says stop; at each sample, `work` for its agents into
+/// `out`, then a barrier (the outputs are ready for the caller).
+pub(super) fn work<T: Send>(
+    mut share: Share<'_>,
+    board: &Board,
+    plan: Plan<'_>,
+    from: u64,
+    (work, out): (&(impl PerAgent<T> + Sync), &Mutex<Vec<T>>),
+) {
     for n in from..plan.schedule.steps() {
         share.step(board, plan, n, None);
+        if plan.sample_due(n + 1) && has_outputs::<T>() {
+            share.outputs(work, &board.leader.load(), &mut lock(out));
+            board.barrier.wait();
+        }
         board.barrier.wait();
         if board.stop.load(SeqCst) {
             return;
         }
+    }
+}
+
+/// The caller's side at a sample: its own share's outputs, the barrier
+/// after which every share's are ready, then all of them in network order
+/// into `all`. Work that gives nothing (a zero-sized `T`) is done here,
+/// on `states` (every agent's, read from the board).
+pub(super) fn gather<T>(
+    mine: &Share<'_>,
+    board: &Board,
+    (work, outs): (&impl PerAgent<T>, &[Mutex<Vec<T>>]),
+    (leader, states): (&LeaderState, &[AgentState]),
+    all: &mut Vec<T>,
+) {
+    all.clear();
+    if !has_outputs::<T>() {
+        all.extend(states.iter().enumerate().map(|(k, x)| work(k, x, leader)));
+        return;
+    }
+    mine.outputs(work, leader, all);
+    board.barrier.wait();
+    for out in &outs[1..] {
+        all.append(&mut lock(out));
     }
 }
 

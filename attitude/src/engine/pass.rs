@@ -1,7 +1,8 @@
 //! One stage of a run of agents, in one pass: each agent receives its
 //! inputs (at an exchange), advances, publishes its next stage state (when
 //! the next stage is an exchange) and, at the end of a step, is checked
-//! against the envelope ([`crate::guard`]). Each agent's data is touched
+//! against the envelope ([`crate::guard`]; before publishing, so that the
+//! check settles the published value's verdict too). Each agent's data is touched
 //! once per stage, while it is in the cache.
 //!
 //! Both the one-thread step and every thread of the crew run this pass:
@@ -12,7 +13,8 @@
 
 use super::board::Judged;
 use crate::agent::Agent;
-use crate::guard::{Envelope, Violation, check_agent};
+use crate::guard::{Envelope, Violation};
+use std::borrow::Borrow;
 
 /// What a stage's pass does besides advancing every agent.
 #[derive(Debug, Clone, Copy)]
@@ -29,32 +31,35 @@ pub(super) struct Stage<'a> {
 }
 
 /// Runs `stage` over `agents` (`nbr_index[k]`: the network indices of agent
-/// `k`'s neighbours). `read(j)` is the value agent `j` of the network
-/// published for this exchange; `write(k, x)` publishes agent `k`'s value
-/// for the next one. Returns the first agent (index in `agents`) whose new
+/// `k`'s neighbours). `read(j)` is (or borrows) the value agent `j` of the network
+/// published for this exchange; `write(k, agent)` publishes agent `k`'s
+/// value for the next one ([`Agent::publish_into`]). Returns the first agent (index in `agents`) whose new
 /// state is outside the envelope, and its violation.
-pub(super) fn pass(
+pub(super) fn pass<J: Borrow<Judged>>(
     agents: &mut [Agent],
     nbr_index: &[Vec<usize>],
     stage: Stage<'_>,
-    read: impl Fn(usize) -> Judged,
-    mut write: impl FnMut(usize, Judged),
+    read: impl Fn(usize) -> J,
+    mut write: impl FnMut(usize, &mut Agent),
 ) -> Option<(usize, Violation)> {
     let mut first = None;
     for (k, (agent, nbrs)) in agents.iter_mut().zip(nbr_index).enumerate() {
-        if let Some(Judged(from_leader, trusted)) = stage.leader {
+        if let Some(Judged(from_leader, trusted)) = &stage.leader {
             for (m, &j) in nbrs.iter().enumerate() {
-                let Judged(x, ok) = read(j);
-                agent.receive_neighbour_judged(m, x, ok);
+                let held = read(j);
+                let Judged(x, ok) = held.borrow();
+                agent.hold_neighbour(m, x, *ok);
             }
-            agent.receive_leader_judged(from_leader, trusted);
+            agent.receive_leader_judged(*from_leader, *trusted);
         }
         agent.advance();
-        if stage.publish {
-            write(k, Judged::of(agent.stage_exchange()));
-        }
+        // The check first: a state it passes needs no second look when
+        // published at the next stage 0 (`Agent::check`).
         if let Some(env) = stage.check.filter(|_| first.is_none()) {
-            first = check_agent(agent.state(), env).map(|v| (k, v));
+            first = agent.check(env).map(|v| (k, v));
+        }
+        if stage.publish {
+            write(k, agent);
         }
     }
     first

@@ -11,9 +11,17 @@
 //! machine disturbs less than the wall clock; on several it counts the
 //! barriers' spinning too) and each thread count's speed-up over the first.
 //!
+//! A second table ([`conditions`]) says what the machine let each figure
+//! have: wall and CPU time, CPU ÷ wall (the cores it kept busy: 2 threads
+//! running in parallel show ≈ 2), and the time its threads were runnable
+//! but waited for a core ([`sched`]), so figures of a shared machine can be
+//! told from an idle one's.
+//!
 //! # Layout
 //! - [`tree`]: the binary tree of any size.
+//! - [`sched`]: the threads' time on a CPU and waiting for one (`schedstat`).
 
+pub mod sched;
 pub mod tree;
 
 use attitude::engine::InProcess;
@@ -46,6 +54,8 @@ pub struct Figure {
     pub cpu_seconds: Option<f64>,
     /// Whether every agent's final state is finite (the run did not diverge).
     pub finite: bool,
+    /// The scheduler's books of the timed steps.
+    pub books: sched::Books,
 }
 
 impl Figure {
@@ -77,6 +87,7 @@ pub fn measure(scheme: SchemeArg, agents: u32, threads: usize, exact: bool, budg
         engine.with_threads(threads)
     };
     engine.step();
+    let watch = sched::Watch::start();
     let cpu = crate::stats::cpu_seconds();
     let started = Instant::now();
     let mut finite = true;
@@ -89,15 +100,18 @@ pub fn measure(scheme: SchemeArg, agents: u32, threads: usize, exact: bool, budg
         }
         true
     });
+    let seconds = started.elapsed().as_secs_f64();
+    let cpu_seconds = cpu.zip(crate::stats::cpu_seconds()).map(|(a, b)| b - a);
     Figure {
         scheme,
         agents,
         asked: threads,
         threads: engine.threads(),
         steps,
-        seconds: started.elapsed().as_secs_f64(),
-        cpu_seconds: cpu.zip(crate::stats::cpu_seconds()).map(|(a, b)| b - a),
+        seconds,
+        cpu_seconds,
         finite,
+        books: watch.stop(),
     }
 }
 
@@ -138,6 +152,33 @@ pub fn table(figures: &[Figure], threads: &[usize]) -> String {
                 _ => s.push_str(" – |"),
             }
         }
+    }
+    s.push('\n');
+    s
+}
+
+/// The Markdown table of what the machine gave each figure: wall s, CPU s
+/// (`/proc`, every thread), CPU ÷ wall, and the threads' time on a CPU
+/// and runnable but waiting for one (`schedstat`, summed over threads).
+pub fn conditions(figures: &[Figure]) -> String {
+    let mut s = String::from(
+        "| scheme | N | threads (used) | wall s | CPU s | CPU ÷ wall | on a CPU s | waiting for a CPU s |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|",
+    );
+    for f in figures {
+        let cpu = f.cpu_seconds.map_or("–".into(), |c| format!("{c:.2}"));
+        let busy = (f.cpu_seconds).map_or("–".into(), |c| format!("{:.2}", c / f.seconds));
+        let _ = write!(
+            s,
+            "\n| {} | {} | {} ({}) | {:.2} | {cpu} | {busy} | {:.2} | {:.2} |",
+            f.scheme.name(),
+            f.agents,
+            f.asked,
+            f.threads,
+            f.seconds,
+            f.books.on_cpu,
+            f.books.waiting
+        );
     }
     s.push('\n');
     s
@@ -208,5 +249,15 @@ mod tests {
             Some(7),
             "{t}"
         );
+    }
+
+    #[test]
+    fn the_conditions_have_a_row_per_figure() {
+        let f = measure(SchemeArg::ObserverConstant, 200, 2, false, 20_000);
+        assert_eq!((f.threads, f.steps), (2, 100));
+        let c = conditions(&[f.clone(), f]);
+        assert_eq!(c.lines().count(), 4, "{c}");
+        assert!(c.contains("| observer-constant | 200 | 2 (2) |"), "{c}");
+        assert_eq!(c.lines().nth(1).map(|l| l.matches(":|").count()), Some(7));
     }
 }

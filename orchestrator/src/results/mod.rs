@@ -6,7 +6,8 @@
 //! - [`layout`]: the name of every file and directory of a run and of a
 //!   sweep (`RunLayout`, `SweepLayout`, the staging directory's name).
 //! - this module: [`Recorder`] (snapshots → `errors.csv` rows and
-//!   [`Series`], and `states.bin`), [`agent_summaries`], [`write_summary`],
+//!   [`Series`], and `states.bin`; each agent's [`Row`] made where the
+//!   engine likes), [`agent_summaries`], [`write_summary`],
 //!   [`WriteError`] (naming the file).
 //! - [`summary`]: `summary.json` ([`Summary`]) and the end-of-run table.
 //! - [`states`]: `states.bin`, its byte layout, reader and CSV export.
@@ -29,8 +30,9 @@ pub mod states;
 pub mod summary;
 
 use attitude::engine::Snapshot;
-use attitude::metrics::errors;
-use attitude::network::Network;
+use attitude::metrics::{Errors, errors};
+use attitude::network::{AgentState, Network};
+use attitude::reference::LeaderState;
 pub use layout::{RunLayout, SweepLayout};
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -86,6 +88,35 @@ pub struct Recorder {
     series: Vec<Series>,
 }
 
+/// One agent's part of a sample's record: its errors and the end of its
+/// `errors.csv` row after the time (`,id,att,angvel,obs_att,obs_angvel`,
+/// the observer's two empty without an observer).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    errors: Errors,
+    tail: String,
+}
+
+impl Row {
+    /// The row of agent `id` with errors `e`.
+    fn of(id: u32, e: &Errors) -> Self {
+        let tail = match e.observer {
+            Some((oa, ow)) => format!(",{id},{},{},{oa},{ow}", e.att, e.angvel),
+            None => format!(",{id},{},{},,", e.att, e.angvel),
+        };
+        Self { errors: *e, tail }
+    }
+}
+
+/// Every agent's row of `snap` in order, made by `row` ([`Recorder::row_maker`]) here.
+pub fn rows_of(
+    row: &impl Fn(usize, &AgentState, &LeaderState) -> Row,
+    snap: &Snapshot<'_>,
+) -> Vec<Row> {
+    let agents = snap.agents.iter().enumerate();
+    agents.map(|(k, x)| row(k, x, snap.leader)).collect()
+}
+
 /// Formats a sample time `step · dt` without binary noise (9 decimals, trimmed).
 #[must_use]
 pub fn fmt_time(step: u64, dt: f64) -> String {
@@ -132,32 +163,42 @@ impl Recorder {
     /// Writes one row per agent for `snap`. Errors are printed with Rust's
     /// shortest round-trip formatting (full f64 precision).
     pub fn record(&mut self, snap: &Snapshot<'_>) -> Result<(), WriteError> {
+        let rows = rows_of(&self.row_maker(), snap);
+        self.record_rows(snap, &rows)
+    }
+
+    /// The per-agent part of [`Recorder::record`] (agent index, state, the
+    /// leader's state → its [`Row`]): pure, so an engine may make each
+    /// agent's row on the thread that steps it
+    /// ([`attitude::engine::InProcess::run_with`]).
+    pub fn row_maker(&self) -> impl Fn(usize, &AgentState, &LeaderState) -> Row + Sync + use<> {
+        let ids: Vec<u32> = self.series.iter().map(|s| s.id).collect();
+        let has_observer = self.has_observer;
+        move |k, x, leader| Row::of(ids[k], &errors(x, leader, has_observer))
+    }
+
+    /// [`Recorder::record`] with the rows made already (one per agent, in
+    /// network order, by [`Recorder::row_maker`]).
+    pub fn record_rows(&mut self, snap: &Snapshot<'_>, rows: &[Row]) -> Result<(), WriteError> {
         (self.states.write(snap)).map_err(writing(&self.files.states()))?;
-        self.record_errors(snap)
+        self.record_errors(snap.step, rows)
             .map_err(writing(&self.files.errors_csv()))
     }
 
-    /// The `errors.csv` rows and series samples of `snap`.
-    fn record_errors(&mut self, snap: &Snapshot<'_>) -> io::Result<()> {
-        let t_str = fmt_time(snap.step, self.dt);
+    /// The `errors.csv` rows and series samples of step `step`.
+    fn record_errors(&mut self, step: u64, rows: &[Row]) -> io::Result<()> {
+        let t_str = fmt_time(step, self.dt);
         let t: f64 = t_str.parse().expect("fmt_time prints a number");
-        for (x, s) in snap.agents.iter().zip(&mut self.series) {
-            let e = errors(x, snap.leader, self.has_observer);
+        for (row, s) in rows.iter().zip(&mut self.series) {
+            let e = &row.errors;
             s.t.push(t);
             s.att.push(e.att);
             s.angvel.push(e.angvel);
-            match e.observer {
-                Some((oa, ow)) => {
-                    s.obs_att.push(oa);
-                    s.obs_angvel.push(ow);
-                    writeln!(
-                        self.csv,
-                        "{t_str},{},{},{},{oa},{ow}",
-                        s.id, e.att, e.angvel
-                    )?;
-                }
-                None => writeln!(self.csv, "{t_str},{},{},{},,", s.id, e.att, e.angvel)?,
+            if let Some((oa, ow)) = e.observer {
+                s.obs_att.push(oa);
+                s.obs_angvel.push(ow);
             }
+            writeln!(self.csv, "{t_str}{}", row.tail)?;
         }
         Ok(())
     }

@@ -1,0 +1,134 @@
+//! The engine's verdict on an agent's own published value
+//! (`Agent::stage_exchange_judged`, proven within a step by
+//! `attitude::verdict`) is exactly `Exchanged::trust().is_ok()` at every
+//! stage: for a network that converges, for one whose `dt` is far too large
+//! (its states blow up, turn non-finite, and its attitudes stop being
+//! rotations), and for each scheme.
+
+use attitude::agent::Agent;
+use attitude::body::Inertia;
+use attitude::control::ControlGains;
+use attitude::network::{AgentModel, AgentState, Exchanged, Neighbour, Scheme};
+use attitude::observer::ObserverGains;
+use attitude::reference::{Leader, LeaderState};
+use attitude::so3::rot;
+use nalgebra::{Matrix3, Vector3};
+
+fn diag(c: f64) -> Matrix3<f64> {
+    Matrix3::from_diagonal(&Vector3::new(c, c + 1.0, c + 2.0))
+}
+
+fn schemes(gain: f64) -> [Scheme; 3] {
+    let observer = ObserverGains {
+        k_r: 9.0 * gain,
+        k_w: 14.0 * gain,
+        k_sigma: 12.0 * gain,
+    };
+    let control = ControlGains {
+        k_r: 8.0 * gain,
+        k_w: 13.0 * gain,
+    };
+    [
+        Scheme::ObserverTimeVarying { observer, control },
+        Scheme::ObserverConstant { observer, control },
+        Scheme::Observerless { control },
+    ]
+}
+
+/// A chain of `n` agents (agent 1 hears the leader) under `scheme`.
+fn chain(n: u32, scheme: Scheme, dt: f64) -> (Leader, Vec<Agent>) {
+    let p = Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.0, -0.7, 0.0, 0.7, 0.0);
+    let axis = Vector3::new(1.0, 2.0, -0.5).normalize();
+    let agents = (1..=n)
+        .map(|id| {
+            let nbr = |j: u32| Neighbour {
+                id: j,
+                a: diag(1.0 + f64::from(j % 2)),
+                link: None,
+            };
+            let neighbours = [id - 1, id + 1]
+                .into_iter()
+                .filter(|&j| j >= 1 && j <= n)
+                .map(nbr)
+                .collect();
+            let model = AgentModel {
+                id,
+                inertia: Inertia::new(diag(0.1 * f64::from(id))),
+                a_bar: diag(1.0),
+                neighbours,
+                leader_gain: (id == 1).then(|| diag(4.0)),
+                leader_link: None,
+                scheme,
+                p,
+                law: Default::default(),
+            };
+            let r = rot(0.5 + 0.7 * f64::from(id), &axis);
+            let initial = AgentState {
+                r,
+                w: Vector3::new(0.3, -0.2, 0.1) * f64::from(id),
+                r_hat: r.transpose(),
+                w_hat: Vector3::zeros(),
+                s_hat: Vector3::new(0.0, 0.1, 0.0),
+            };
+            Agent::new(model, initial, dt)
+        })
+        .collect();
+    let leader = LeaderState {
+        r0: Matrix3::identity(),
+        w0: Vector3::new(0.1, 0.2, 0.0),
+        s0: Vector3::new(0.1, 0.0, 0.0),
+    };
+    (Leader::new(p, leader, dt), agents)
+}
+
+/// Steps the chain for `steps` steps, continuous coupling, checking every
+/// published verdict; returns how many values were trusted and refused.
+fn check(scheme: Scheme, dt: f64, steps: usize) -> (usize, usize) {
+    let (mut leader, mut agents) = chain(5, scheme, dt);
+    let (mut yes, mut no) = (0, 0);
+    for _ in 0..steps * 4 {
+        let mut published: Vec<(Exchanged, bool)> = Vec::new();
+        for a in &mut agents {
+            let (x, trusted) = a.stage_exchange_judged();
+            assert_eq!(trusted, x.trust().is_ok(), "{scheme:?}, {x:?}");
+            if trusted {
+                yes += 1
+            } else {
+                no += 1
+            }
+            published.push((x, trusted));
+        }
+        let from_leader = leader.stage_exchange();
+        for (k, a) in agents.iter_mut().enumerate() {
+            let ids: Vec<usize> = (a.model().neighbours.iter())
+                .map(|n| n.id as usize - 1)
+                .collect();
+            for (m, j) in ids.into_iter().enumerate() {
+                let (x, trusted) = published[j];
+                a.receive_neighbour_judged(m, x, trusted);
+            }
+            if k == 0 {
+                a.receive_leader(from_leader);
+            }
+            a.advance();
+        }
+        leader.advance();
+    }
+    (yes, no)
+}
+
+#[test]
+fn verdicts_equal_trust_while_converging() {
+    for scheme in schemes(1.0) {
+        let (yes, no) = check(scheme, 1e-3, 2_000);
+        assert_eq!((yes, no), (5 * 4 * 2_000, 0), "{scheme:?}");
+    }
+}
+
+#[test]
+fn verdicts_equal_trust_while_diverging() {
+    for scheme in schemes(50.0) {
+        let (yes, no) = check(scheme, 0.2, 60);
+        assert!(yes > 0 && no > 0, "{scheme:?}: {yes} trusted, {no} refused");
+    }
+}
