@@ -566,11 +566,24 @@ mod tests {
             .collect();
         assert_eq!(
             names,
-            ["r", "omega", "r_hat", "omega_hat", "sigma_hat", "r0", "omega0", "sigma0"]
+            [
+                "r",
+                "omega",
+                "r_hat",
+                "omega_hat",
+                "sigma_hat",
+                "r0",
+                "omega0",
+                "sigma0"
+            ]
         );
         let codes: std::collections::BTreeSet<u32> =
             Quantity::ALL.into_iter().map(quantity_code).collect();
-        assert_eq!(codes.len(), Quantity::ALL.len(), "two quantities share a code");
+        assert_eq!(
+            codes.len(),
+            Quantity::ALL.len(),
+            "two quantities share a code"
+        );
         for q in Quantity::ALL {
             assert_eq!(quantity_of_code(quantity_code(q)), Some(q));
         }

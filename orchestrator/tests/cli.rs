@@ -14,7 +14,7 @@
 
 mod common;
 
-use common::{OBSERVERLESS, PAPER, Out, attsync, entries, run_args, summary};
+use common::{OBSERVERLESS, Out, PAPER, attsync, entries, run_args, summary};
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};

@@ -19,16 +19,10 @@ fn refused(args: &[&str], option: &str) {
 }
 
 fn run(engine: &str, extra: &[&str]) -> Vec<String> {
-    let mut v: Vec<String> = [
-        "run",
-        PAPER,
-        "--engine",
-        engine,
-        "--quiet",
-    ]
-    .iter()
-    .map(|s| (*s).to_string())
-    .collect();
+    let mut v: Vec<String> = ["run", PAPER, "--engine", engine, "--quiet"]
+        .iter()
+        .map(|s| (*s).to_string())
+        .collect();
     v.extend(extra.iter().map(|s| (*s).to_string()));
     v
 }
@@ -141,8 +135,5 @@ fn gen_tree_options_are_checked() {
 
 #[test]
 fn check_node_config_of_no_node_is_refused() {
-    refused(
-        &["check", PAPER, "--node-config", "99"],
-        "--node-config",
-    );
+    refused(&["check", PAPER, "--node-config", "99"], "--node-config");
 }

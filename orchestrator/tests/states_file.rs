@@ -10,7 +10,11 @@ use std::path::Path;
 
 /// `attsync export STATES --csv`, in `cwd`.
 fn export_csv(cwd: &Path, states: &Path) -> Out {
-    let args = [OsStr::new("export"), states.as_os_str(), OsStr::new("--csv")];
+    let args = [
+        OsStr::new("export"),
+        states.as_os_str(),
+        OsStr::new("--csv"),
+    ];
     attsync(cwd, &args)
 }
 

@@ -68,7 +68,11 @@ fn a_stiff_scenario_is_refused_naming_dt_the_bound_and_a_step_that_works() {
     assert!(i.reason.contains("fastest mode 8.5e3 s⁻¹"), "{i}");
     let fix = i.reason.split("--set ").nth(1).expect("a fix").to_string();
     assert_eq!(fix, "simulation.dt=0.00025");
-    let ok = load(Path::new(&paper("timevarying")), &sets(&[STIFF_SIGMA, &fix])).expect("the fix works");
+    let ok = load(
+        Path::new(&paper("timevarying")),
+        &sets(&[STIFF_SIGMA, &fix]),
+    )
+    .expect("the fix works");
     assert!(
         ok.resolved
             .warnings
@@ -122,11 +126,7 @@ fn a_step_close_to_the_bound_is_warned_about_not_refused() {
 
 #[test]
 fn the_paper_scenarios_have_a_wide_margin() {
-    for f in [
-        "timevarying",
-        "constant-observer",
-        "constant-observerless",
-    ] {
+    for f in ["timevarying", "constant-observer", "constant-observerless"] {
         let l = load(Path::new(&paper(f)), &[]).expect("valid");
         let est = l.resolved.stiffness.expect("agents");
         assert!(est.dt_max > 10.0 * l.resolved.network.dt, "{f}: {est:?}");
@@ -149,16 +149,8 @@ fn just_below_the_bound_stays_finite_well_above_diverges() {
     let cases: [(&str, &str, f64); 4] = [
         ("timevarying", STIFF_SIGMA, 0.95),
         ("timevarying", "scheme.control.k_omega=2000", 0.95),
-        (
-            "constant-observer",
-            "scheme.observer.k_omega=3000",
-            0.95,
-        ),
-        (
-            "constant-observerless",
-            "scheme.control.k_r=3000",
-            0.95,
-        ),
+        ("constant-observer", "scheme.observer.k_omega=3000", 0.95),
+        ("constant-observerless", "scheme.control.k_r=3000", 0.95),
     ];
     for (file, set, below) in cases {
         let bound = dt_max(file, &[set]);
@@ -191,7 +183,10 @@ fn cli_refuses_a_stiff_scenario_unless_told_not_to() {
         "{err}"
     );
     assert!(err.contains("try --set simulation.dt=0.00025"), "{err}");
-    let out = attsync(dir.path(), &[&check[..], &["--no-stiffness-check"]].concat());
+    let out = attsync(
+        dir.path(),
+        &[&check[..], &["--no-stiffness-check"]].concat(),
+    );
     let text = &out.stdout;
     assert_eq!(out.code, Some(0), "{text}");
     assert!(

@@ -27,7 +27,11 @@ use std::process::Command;
 /// `attsync run PAPER --engine in-process --out OUT --quiet --set …` (0.5 s
 /// unless `sets` say otherwise), expecting exit code `code`.
 fn run(cwd: &Path, out: &Path, sets: &[&str], code: i32) -> PathBuf {
-    let sets: Vec<&str> = ["simulation.duration=0.5"].iter().chain(sets).copied().collect();
+    let sets: Vec<&str> = ["simulation.duration=0.5"]
+        .iter()
+        .chain(sets)
+        .copied()
+        .collect();
     attsync(cwd, &run_args(PAPER, "in-process", out, &sets)).assert_code(code);
     out.to_owned()
 }
