@@ -55,30 +55,30 @@ impl Envelope {
     }
 }
 
-/// A checked part of a node's state.
+/// A checked part of a node's state. Its wire code (PROTOCOL.md § 5,
+/// `Failed` reason 4) belongs to the wire contract: `msgs::telemetry`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u32)]
 pub enum Quantity {
     /// An agent's attitude `Rᵢ`.
-    R = 1,
+    R,
     /// An agent's angular velocity `ωᵢ`.
-    Omega = 2,
+    Omega,
     /// An agent's observed attitude `R̂ᵢ`.
-    RHat = 3,
+    RHat,
     /// An agent's observed angular velocity `ω̂ᵢ`.
-    OmegaHat = 4,
+    OmegaHat,
     /// An agent's observed angular acceleration `σ̂ᵢ`.
-    SigmaHat = 5,
+    SigmaHat,
     /// The leader's attitude `R₀`.
-    R0 = 6,
+    R0,
     /// The leader's angular velocity `ω₀`.
-    Omega0 = 7,
+    Omega0,
     /// The leader's angular acceleration `σ₀`.
-    Sigma0 = 8,
+    Sigma0,
 }
 
 impl Quantity {
-    /// Every quantity, in code order.
+    /// Every quantity, in the states' field order (agent, then leader).
     pub const ALL: [Quantity; 8] = [
         Quantity::R,
         Quantity::Omega,
@@ -103,18 +103,6 @@ impl Quantity {
             Quantity::Omega0 => "omega0",
             Quantity::Sigma0 => "sigma0",
         }
-    }
-
-    /// Its wire code (PROTOCOL.md § 5, `Failed` reason 4).
-    #[must_use]
-    pub fn code(self) -> u32 {
-        self as u32
-    }
-
-    /// The quantity of wire code `code`.
-    #[must_use]
-    pub fn from_code(code: u32) -> Option<Self> {
-        Self::ALL.into_iter().find(|q| q.code() == code)
     }
 
     /// Whether it is an attitude (checked to be a rotation, not against a bound).
@@ -404,15 +392,6 @@ mod tests {
             check_leader(&l, &Envelope::default()).map(|v| v.quantity),
             Some(Quantity::Sigma0)
         );
-    }
-
-    #[test]
-    fn wire_codes_round_trip() {
-        for q in Quantity::ALL {
-            assert_eq!(Quantity::from_code(q.code()), Some(q));
-        }
-        assert_eq!(Quantity::from_code(0), None);
-        assert_eq!(Quantity::from_code(9), None);
     }
 
     #[test]

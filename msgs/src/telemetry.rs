@@ -144,6 +144,32 @@ const REASON_BAD_INPUT: u32 = 2;
 const REASON_OTHER: u32 = 3;
 const REASON_DIVERGED: u32 = 4;
 
+/// The wire code of a diverged [`Quantity`] (`Failed` reason 4, field
+/// `quantity` at offset 32; PROTOCOL.md § 5). The one mapping between the
+/// two: [`quantity_of_code`] is its inverse.
+#[must_use]
+pub fn quantity_code(q: Quantity) -> u32 {
+    match q {
+        Quantity::R => 1,
+        Quantity::Omega => 2,
+        Quantity::RHat => 3,
+        Quantity::OmegaHat => 4,
+        Quantity::SigmaHat => 5,
+        Quantity::R0 => 6,
+        Quantity::Omega0 => 7,
+        Quantity::Sigma0 => 8,
+    }
+}
+
+/// The [`Quantity`] of wire code `code` (`None`: no quantity has it); the
+/// inverse of [`quantity_code`].
+#[must_use]
+pub fn quantity_of_code(code: u32) -> Option<Quantity> {
+    Quantity::ALL
+        .into_iter()
+        .find(|&q| quantity_code(q) == code)
+}
+
 /// A telemetry message that cannot be decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
 pub enum TelemetryError {
@@ -324,7 +350,7 @@ fn encode_failed(b: &mut Writer, f: &FailReason) {
             value,
         } => {
             b.u64(24, step);
-            b.u32(32, quantity.code());
+            b.u32(32, quantity_code(quantity));
             b.f64(40, value);
             (REASON_DIVERGED, 0)
         }
@@ -341,7 +367,7 @@ fn decode_failed(b: &Reader) -> Result<FailReason, TelemetryError> {
         REASON_OTHER => Ok(FailReason::Other),
         REASON_DIVERGED => Ok(FailReason::Diverged {
             step: b.u64(24),
-            quantity: Quantity::from_code(b.u32(32))
+            quantity: quantity_of_code(b.u32(32))
                 .ok_or(TelemetryError::UnknownQuantity(b.u32(32)))?,
             value: b.f64(40),
         }),
@@ -529,6 +555,40 @@ mod tests {
         assert_eq!(m.body[16], 1, "quantity code at offset 32");
         m.body[16] = 99;
         assert_eq!(m.decode(), Err(TelemetryError::UnknownQuantity(99)));
+    }
+
+    #[test]
+    fn quantity_codes_are_a_bijection_onto_protocol_codes_1_to_8() {
+        // PROTOCOL.md § 5: 1 r, 2 omega, 3 r_hat, 4 omega_hat, 5 sigma_hat,
+        // 6 r0, 7 omega0, 8 sigma0.
+        let names: Vec<&str> = (1..=8)
+            .map(|c| quantity_of_code(c).expect("a quantity per code").name())
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "r",
+                "omega",
+                "r_hat",
+                "omega_hat",
+                "sigma_hat",
+                "r0",
+                "omega0",
+                "sigma0"
+            ]
+        );
+        let codes: std::collections::BTreeSet<u32> =
+            Quantity::ALL.into_iter().map(quantity_code).collect();
+        assert_eq!(
+            codes.len(),
+            Quantity::ALL.len(),
+            "two quantities share a code"
+        );
+        for q in Quantity::ALL {
+            assert_eq!(quantity_of_code(quantity_code(q)), Some(q));
+        }
+        assert_eq!(quantity_of_code(0), None);
+        assert_eq!(quantity_of_code(9), None);
     }
 
     #[test]

@@ -7,30 +7,24 @@
 //!   (`/dev/zero`) — with a message naming the file, the limit and the size;
 //! - a huge line of input is never echoed whole in a message.
 
+mod common;
+
+use common::PAPER;
+use std::ffi::OsString;
 use std::fs;
 use std::path::Path;
-use std::process::Command;
-
-const PAPER: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/timevarying.toml"
-);
 
 /// The size limit, in bytes, as printed.
 const LIMIT: &str = "268435456";
 
 /// Exit code and stderr of `attsync check FILE --set …`.
 fn check(file: &Path, sets: &[&str]) -> (Option<i32>, String) {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_attsync"));
-    cmd.arg("check").arg(file);
+    let mut args: Vec<OsString> = vec!["check".into(), file.into()];
     for s in sets {
-        cmd.args(["--set", s]);
+        args.extend(["--set".into(), (*s).into()]);
     }
-    let out = cmd.output().expect("attsync starts");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let out = common::attsync(Path::new(env!("CARGO_MANIFEST_DIR")), &args);
+    (out.code, out.stderr)
 }
 
 /// `text` with the first occurrence of `from` replaced by `to`.

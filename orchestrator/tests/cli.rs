@@ -12,19 +12,13 @@
 //!   never replaces a directory that is not earlier attsync results;
 //! - runs and generated scenarios are deterministic (byte-identical).
 
+mod common;
+
+use common::{OBSERVERLESS, Out, PAPER, attsync, entries, run_args, summary};
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-const PAPER: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/timevarying.toml"
-);
-const OBSERVERLESS: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/constant-observerless.toml"
-);
 const HEADER: &str = "t,agent,att_err,angvel_err,obs_att_err,obs_angvel_err";
 const RESULT_FILES: [&str; 8] = [
     ".attsync-run",
@@ -37,64 +31,9 @@ const RESULT_FILES: [&str; 8] = [
     "view.html",
 ];
 
-/// What a finished `attsync` process left.
-struct Out {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-impl Out {
-    #[track_caller]
-    fn assert_ok(&self) -> &Self {
-        assert_eq!(
-            self.code,
-            Some(0),
-            "attsync failed:\n--- stdout\n{}\n--- stderr\n{}",
-            self.stdout,
-            self.stderr
-        );
-        self
-    }
-}
-
-/// Runs `attsync args…` with `cwd` as working directory.
-fn attsync<S: AsRef<std::ffi::OsStr>>(cwd: &Path, args: &[S]) -> Out {
-    let out = Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("attsync starts");
-    Out {
-        code: out.status.code(),
-        stdout: String::from_utf8(out.stdout).expect("UTF-8 stdout"),
-        stderr: String::from_utf8(out.stderr).expect("UTF-8 stderr"),
-    }
-}
-
-/// `attsync run SCENARIO --engine in-process --out OUT --set …`.
+/// `attsync run SCENARIO --engine in-process --out OUT --quiet --set …`.
 fn run(cwd: &Path, scenario: &str, out: &Path, sets: &[&str]) -> Out {
-    let mut args: Vec<String> = vec![
-        "run".into(),
-        scenario.into(),
-        "--engine".into(),
-        "in-process".into(),
-        "--out".into(),
-        out.display().to_string(),
-    ];
-    for s in sets {
-        args.push("--set".into());
-        args.push((*s).into());
-    }
-    attsync(cwd, &args)
-}
-
-/// Names of the entries of `dir`.
-fn entries(dir: &Path) -> BTreeSet<String> {
-    fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect()
+    attsync(cwd, &run_args(scenario, "in-process", out, sets))
 }
 
 fn names(list: &[&str]) -> BTreeSet<String> {
@@ -110,11 +49,6 @@ fn read_csv(dir: &Path) -> (String, Vec<Vec<String>>) {
         .map(|l| l.split(',').map(str::to_string).collect())
         .collect();
     (header, rows)
-}
-
-fn read_summary(dir: &Path) -> serde_json::Value {
-    let text = fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    serde_json::from_str(&text).expect("summary.json is JSON")
 }
 
 /// The sample time `k · 0.01` as `errors.csv` prints it: no binary noise.
@@ -260,7 +194,7 @@ fn run_paper_scenario_writes_complete_results() {
 
     check_csv(&dir, 0.5, true);
 
-    let s = read_summary(&dir);
+    let s = summary(&dir);
     assert_eq!(s["complete"], true, "{s:#}");
     assert!(s["incomplete_reason"].is_null(), "{s:#}");
     assert_eq!(s["t_end"].as_f64(), Some(0.5), "{s:#}");
@@ -314,7 +248,7 @@ fn run_observerless_leaves_observer_columns_empty() {
         "observer columns not empty"
     );
     check_csv(&dir, 0.5, false);
-    let s = read_summary(&dir);
+    let s = summary(&dir);
     for a in s["agents"].as_array().unwrap() {
         assert!(a["final_obs_att_err"].is_null(), "{a:#}");
         assert!(a["final_obs_angvel_err"].is_null(), "{a:#}");
@@ -334,7 +268,7 @@ fn run_twice_into_the_same_directory_replaces_the_results() {
         "staging or old directory left behind"
     );
     check_csv(&dir, 0.2, true);
-    assert_eq!(read_summary(&dir)["t_end"].as_f64(), Some(0.2));
+    assert_eq!(summary(&dir)["t_end"].as_f64(), Some(0.2));
     let eff: toml::Table = fs::read_to_string(dir.join("scenario.toml"))
         .unwrap()
         .parse()
@@ -424,7 +358,7 @@ fn runs_are_deterministic() {
     check_csv(&a, 1.0, true);
     // summary.json too, apart from the wall-clock time.
     let strip = |d: &PathBuf| {
-        let mut s = read_summary(d);
+        let mut s = summary(d);
         s.as_object_mut().unwrap().remove("wall_seconds");
         s
     };

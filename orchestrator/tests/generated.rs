@@ -5,10 +5,13 @@
 //! many seeds and sizes and each scheme, must validate without a step-size
 //! warning and stay finite over a short horizon.
 
+mod common;
+
 use attitude::engine::InProcess;
 use attsync::generate::{DT_FRACTION, TreeParams, tree};
 use attsync::scenario::schema::SchemeKind;
 use attsync::scenario::{Loaded, load_str};
+use common::stays_finite;
 use std::path::Path;
 
 const SCHEMES: [SchemeKind; 3] = [
@@ -36,20 +39,6 @@ fn generate(agents: u32, leader_links: u32, seed: u64, scheme: SchemeKind) -> Lo
         .unwrap_or_else(|e| panic!("{agents} agents, seed {seed}, {scheme:?}: {e}"))
 }
 
-/// Every state finite and below 1e6 over the whole (short) run.
-fn stays_finite(l: &Loaded) -> bool {
-    let mut ok = true;
-    InProcess::new(&l.resolved.network).run(|s| {
-        ok = s.agents.iter().all(|a| {
-            [a.w, a.w_hat, a.s_hat]
-                .iter()
-                .all(|v| v.iter().all(|x| x.is_finite() && x.abs() < 1e6))
-        });
-        ok
-    });
-    ok
-}
-
 fn check(agents: u32, leader_links: u32, seed: u64, scheme: SchemeKind) {
     let l = generate(agents, leader_links, seed, scheme);
     let what = format!("{agents} agents, {leader_links} links, seed {seed}, {scheme:?}");
@@ -69,7 +58,7 @@ fn check(agents: u32, leader_links: u32, seed: u64, scheme: SchemeKind) {
             "{what}"
         );
     }
-    assert!(stays_finite(&l), "{what}: diverged");
+    assert!(stays_finite(&l.resolved.network), "{what}: diverged");
 }
 
 #[test]

@@ -24,12 +24,14 @@
 //!
 //! Measured (dt = 1 ms, 40 s): see the constants' docs.
 
+mod common;
+
 use attitude::engine::InProcess;
 use attitude::metrics::errors;
-use attsync::scenario::{Loaded, load};
+use attsync::scenario::Loaded;
+use common::load_paper;
 use nalgebra::{Matrix3, Vector3, Vector4};
 use std::f64::consts::PI;
-use std::path::PathBuf;
 
 /// Under the printed law every agent's final attitude error is at least
 /// this: measured 5.7e-3 (agent 7) to 8.7e-3 (agent 1), in attsync and in
@@ -47,14 +49,6 @@ const SAME_ORDER: f64 = 3.0;
 /// … and, closer, within this relative difference: both are 4th-order
 /// integrations of one closed loop at dt = 1 ms (measured: 5.9e-10).
 const SAME_CURVE: f64 = 1e-6;
-
-fn scenario(name: &str, set: &[&str]) -> Loaded {
-    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios/paper")
-        .join(name);
-    let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
-    load(&file, &set).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// Every agent's `|Rᵢ R₀ᵀ|_I` at the last sample (40 s), and the whole
 /// error curves `(step, att_err per agent)` for comparisons.
@@ -83,8 +77,8 @@ const PRINTED: &str = "scheme.law=\"as-printed\"";
 
 #[test]
 fn scheme_1_stalls_under_the_printed_law_and_converges_under_the_corrected_one() {
-    let (printed, _) = final_errors(&scenario("timevarying.toml", &[PRINTED]));
-    let (corrected, _) = final_errors(&scenario("timevarying.toml", &[]));
+    let (printed, _) = final_errors(&load_paper("timevarying", &[PRINTED]));
+    let (corrected, _) = final_errors(&load_paper("timevarying", &[]));
     let c = max(&corrected);
     eprintln!(
         "scheme 1 at 40 s: printed {}, corrected {}",
@@ -97,7 +91,7 @@ fn scheme_1_stalls_under_the_printed_law_and_converges_under_the_corrected_one()
 
 #[test]
 fn an_independent_rk4_of_the_printed_law_stalls_alike() {
-    let (attsync, _) = final_errors(&scenario("timevarying.toml", &[PRINTED]));
+    let (attsync, _) = final_errors(&load_paper("timevarying", &[PRINTED]));
     let printed = reference::final_att_errors(reference::Law::AsPrinted);
     let corrected = reference::final_att_errors(reference::Law::Corrected);
     let c = max(&corrected);
@@ -139,8 +133,8 @@ fn assert_stalls(what: &str, errors: &[f64]) {
 
 #[test]
 fn scheme_2_runs_the_printed_gamma_and_still_converges() {
-    let (printed, pc) = final_errors(&scenario("constant-observer.toml", &[PRINTED]));
-    let (corrected, cc) = final_errors(&scenario("constant-observer.toml", &[]));
+    let (printed, pc) = final_errors(&load_paper("constant-observer", &[PRINTED]));
+    let (corrected, cc) = final_errors(&load_paper("constant-observer", &[]));
     eprintln!(
         "scheme 2 at 40 s: printed {}, corrected {}",
         sci(&printed),

@@ -7,52 +7,12 @@
 //!
 //! Each test runs the built binary in its own temporary directory.
 
+mod common;
+
+use common::{Out, attsync, entries, json, paper, read, run_args};
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::Path;
-use std::process::Command;
-
-fn paper(name: &str) -> String {
-    format!(
-        "{}/../scenarios/paper/{name}.toml",
-        env!("CARGO_MANIFEST_DIR")
-    )
-}
-
-/// What a finished `attsync` process left.
-struct Out {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-impl Out {
-    #[track_caller]
-    fn assert_code(&self, code: i32) -> &Self {
-        assert_eq!(
-            self.code,
-            Some(code),
-            "--- stdout\n{}\n--- stderr\n{}",
-            self.stdout,
-            self.stderr
-        );
-        self
-    }
-}
-
-fn attsync<S: AsRef<std::ffi::OsStr>>(cwd: &Path, args: &[S]) -> Out {
-    let out = Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .env_remove("ATTSYNC_LOG")
-        .output()
-        .expect("attsync starts");
-    Out {
-        code: out.status.code(),
-        stdout: String::from_utf8(out.stdout).expect("UTF-8 stdout"),
-        stderr: String::from_utf8(out.stderr).expect("UTF-8 stderr"),
-    }
-}
 
 /// `attsync mc SCENARIO --trials N --out OUT --quiet EXTRA…`.
 fn mc(cwd: &Path, scenario: &str, trials: u64, out: &str, extra: &[&str]) -> Out {
@@ -60,14 +20,6 @@ fn mc(cwd: &Path, scenario: &str, trials: u64, out: &str, extra: &[&str]) -> Out
     let mut args = vec!["mc", scenario, "--trials", &trials, "--out", out, "--quiet"];
     args.extend_from_slice(extra);
     attsync(cwd, &args)
-}
-
-fn read(path: &Path) -> String {
-    fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&read(path)).expect("JSON")
 }
 
 /// The rows of `trials.csv` in `dir`, as fields.
@@ -82,13 +34,6 @@ fn trials(dir: &Path) -> Vec<Vec<String>> {
     );
     lines
         .map(|l| l.split(',').map(str::to_string).collect())
-        .collect()
-}
-
-fn entries(dir: &Path) -> BTreeSet<String> {
-    fs::read_dir(dir)
-        .expect("a directory")
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect()
 }
 
@@ -186,23 +131,11 @@ fn trial_k_alone_and_the_printed_run_line_give_row_k() {
         alone.stdout
     );
     // The printed line reruns it: the same errors.csv, byte for byte.
-    let mut args = vec![
-        "run".to_string(),
-        s.clone(),
-        "--engine".into(),
-        "in-process".into(),
-        "--out".into(),
-        "rerun".into(),
-        "--quiet".into(),
-    ];
     let printed = printed_sets(&alone.stdout);
     assert_eq!(printed[0], "simulation.duration=3");
     assert!(printed.len() > 7 * 4, "{printed:?}");
-    for p in printed {
-        args.push("--set".into());
-        args.push(p);
-    }
-    attsync(tmp.path(), &args).assert_code(0);
+    let printed: Vec<&str> = printed.iter().map(String::as_str).collect();
+    attsync(tmp.path(), &run_args(&s, "in-process", "rerun", &printed)).assert_code(0);
     let (a, b) = (tmp.path().join("t3"), tmp.path().join("rerun"));
     assert_eq!(read(&a.join("errors.csv")), read(&b.join("errors.csv")));
     assert_eq!(
@@ -323,19 +256,8 @@ fn only_the_dispersed_values_are_drawn_and_the_others_keep_their_draws() {
 #[test]
 fn run_accepts_a_scenario_with_a_monte_carlo_table() {
     let tmp = tempfile::tempdir().unwrap();
-    let args = [
-        "run",
-        &paper("constant-observerless"),
-        "--engine",
-        "in-process",
-        "--out",
-        "r",
-        "--quiet",
-        "--set",
-        "monte_carlo.omega_max=2",
-        "--set",
-        SHORT,
-    ];
+    let sets = ["monte_carlo.omega_max=2", SHORT];
+    let args = run_args(paper("constant-observerless"), "in-process", "r", &sets);
     attsync(tmp.path(), &args).assert_code(0);
 }
 

@@ -9,23 +9,18 @@
 //! test command and `.ci/run` run `tools/test-deps.sh`, which does it).
 #![cfg(feature = "mcap")]
 
+mod common;
+
+use common::{Out, attsync, paper, run_args};
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn attsync() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_attsync"))
-}
-
-fn scenario(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios/paper")
-        .join(name)
-}
 
 fn read_check() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/mcap/read_check.py")
 }
 
+/// The stdout of the Python checker, after asserting its success.
 #[track_caller]
 fn ok(out: &Output) -> String {
     assert!(
@@ -51,24 +46,21 @@ fn require_python_mcap() {
 
 /// `attsync run NAME --engine in-process` for 0.1 s (11 samples) into `out`.
 fn paper_run(name: &str, out: &Path) {
-    let r = attsync()
-        .args(["run", "--engine", "in-process", "--quiet"])
-        .args(["--set", "simulation.duration=0.1"])
-        .arg(scenario(name))
-        .arg("--out")
-        .arg(out)
-        .output()
-        .unwrap();
-    ok(&r);
+    let args = run_args(paper(name), "in-process", out, &["simulation.duration=0.1"]);
+    attsync(out.parent().expect("a parent"), &args).assert_ok();
 }
 
-fn export(states: &Path, args: &[&str]) -> Output {
-    attsync()
-        .arg("export")
-        .arg(states)
-        .args(args)
-        .output()
-        .unwrap()
+/// `attsync export STATES ARGS…`, in the directory of `states`.
+fn export(states: &Path, args: &[&str]) -> Out {
+    let mut all: Vec<OsString> = vec!["export".into(), states.into()];
+    all.extend(args.iter().map(Into::into));
+    attsync(states.parent().expect("a parent"), &all)
+}
+
+/// The stdout of a successful `export`.
+#[track_caller]
+fn exported(states: &Path, args: &[&str]) -> String {
+    export(states, args).assert_ok().stdout.clone()
 }
 
 /// Runs `name`, exports both ways, reads the recording back in Python; returns
@@ -80,8 +72,8 @@ fn round_trip(name: &str) -> (String, String) {
     paper_run(name, &run);
     let states = run.join("states.bin");
     let csv = dir.path().join("states.csv");
-    ok(&export(&states, &["--csv", "--out", csv.to_str().unwrap()]));
-    let said = ok(&export(&states, &["--mcap"]));
+    exported(&states, &["--csv", "--out", csv.to_str().unwrap()]);
+    let said = exported(&states, &["--mcap"]);
     let recording = run.join("states.mcap");
     assert!(
         recording.is_file(),
@@ -97,7 +89,7 @@ fn round_trip(name: &str) -> (String, String) {
 
 #[test]
 fn the_observer_run_reads_back_with_every_frame_and_error() {
-    let (said, checked) = round_trip("timevarying.toml");
+    let (said, checked) = round_trip("timevarying");
     assert!(
         said.contains("11 samples, 8 channels, 88 messages"),
         "{said}"
@@ -113,7 +105,7 @@ fn the_observer_run_reads_back_with_every_frame_and_error() {
 
 #[test]
 fn the_observerless_run_reads_back_without_estimates() {
-    let (_, checked) = round_trip("constant-observerless.toml");
+    let (_, checked) = round_trip("constant-observerless");
     assert!(
         checked.contains("mcap ok: 11 samples, 7 agents, 8 channels, 88 messages, observer false"),
         "{checked}"
@@ -124,21 +116,18 @@ fn the_observerless_run_reads_back_without_estimates() {
 fn out_names_the_recording_and_csv_and_mcap_exclude_each_other() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    paper_run("constant-observerless.toml", &run);
+    paper_run("constant-observerless", &run);
     let states = run.join("states.bin");
     let file = dir.path().join("elsewhere.mcap");
-    ok(&export(
-        &states,
-        &["--mcap", "--out", file.to_str().unwrap()],
-    ));
+    exported(&states, &["--mcap", "--out", file.to_str().unwrap()]);
     let bytes = std::fs::read(&file).unwrap();
     assert_eq!(&bytes[..8], b"\x89MCAP0\r\n", "MCAP magic");
     assert_eq!(&bytes[bytes.len() - 8..], b"\x89MCAP0\r\n", "closed file");
     assert!(!run.join("states.mcap").exists());
     for args in [&["--csv", "--mcap"][..], &[][..]] {
         let r = export(&states, args);
-        assert_eq!(r.status.code(), Some(2), "{args:?}: a usage error");
-        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.code, Some(2), "{args:?}: a usage error");
+        let err = &r.stderr;
         assert!(err.contains("--csv") && err.contains("--mcap"), "{err}");
     }
 }
@@ -147,14 +136,14 @@ fn out_names_the_recording_and_csv_and_mcap_exclude_each_other() {
 fn a_truncated_states_file_leaves_no_recording() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    paper_run("constant-observerless.toml", &run);
+    paper_run("constant-observerless", &run);
     let states = run.join("states.bin");
     let mut bytes = std::fs::read(&states).unwrap();
     bytes.truncate(bytes.len() - 7);
     std::fs::write(&states, bytes).unwrap();
     let r = export(&states, &["--mcap"]);
-    assert_eq!(r.status.code(), Some(1));
-    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.code, Some(1));
+    let err = &r.stderr;
     assert!(
         err.contains("states.bin") && err.contains("truncated"),
         "{err}"
@@ -166,10 +155,10 @@ fn a_truncated_states_file_leaves_no_recording() {
 fn a_run_replaces_a_directory_holding_its_recording() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    paper_run("constant-observerless.toml", &run);
-    ok(&export(&run.join("states.bin"), &["--mcap"]));
+    paper_run("constant-observerless", &run);
+    exported(&run.join("states.bin"), &["--mcap"]);
     assert!(run.join("states.mcap").is_file());
-    paper_run("constant-observerless.toml", &run);
+    paper_run("constant-observerless", &run);
     assert!(
         !run.join("states.mcap").exists(),
         "the old recording went with the old results"

@@ -23,90 +23,21 @@
 //!   (bad `--param`, bad value, an unbracketed margin) exiting non-zero,
 //!   naming the field, and leaving nothing behind.
 
+mod common;
+
+use common::{OBSERVERLESS, Out, PAPER, attsync, entries, run_args, summary};
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-const TIMEVARYING: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/timevarying.toml"
-);
-const OBSERVERLESS: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/constant-observerless.toml"
-);
-
-/// What a finished `attsync` process left.
-struct Out {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-impl Out {
-    #[track_caller]
-    fn assert_ok(&self) -> &Self {
-        assert_eq!(
-            self.code,
-            Some(0),
-            "attsync failed:\n--- stdout\n{}\n--- stderr\n{}",
-            self.stdout,
-            self.stderr
-        );
-        self
-    }
-
-    /// Exited by itself (not a signal) with a non-zero code.
-    #[track_caller]
-    fn assert_failed(&self) -> &Self {
-        assert!(self.code.is_some(), "killed by a signal: {}", self.stderr);
-        assert_ne!(self.code, Some(0), "unexpected success:\n{}", self.stdout);
-        self
-    }
-}
-
-/// Runs `attsync args…` with `cwd` as working directory.
-fn attsync<S: AsRef<std::ffi::OsStr>>(cwd: &Path, args: &[S]) -> Out {
-    let out = Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .env_remove("ATTSYNC_BIN_DIR")
-        .output()
-        .expect("attsync starts");
-    Out {
-        code: out.status.code(),
-        stdout: String::from_utf8(out.stdout).expect("UTF-8 stdout"),
-        stderr: String::from_utf8(out.stderr).expect("UTF-8 stderr"),
-    }
-}
 
 /// `attsync run SCENARIO --engine ENGINE --out OUT --quiet --set …`.
 fn run_with(cwd: &Path, engine: &str, scenario: &Path, out: &Path, sets: &[&str]) -> Out {
-    let mut args: Vec<String> = vec![
-        "run".into(),
-        scenario.display().to_string(),
-        "--engine".into(),
-        engine.into(),
-        "--out".into(),
-        out.display().to_string(),
-        "--quiet".into(),
-    ];
-    for s in sets {
-        args.push("--set".into());
-        args.push((*s).into());
-    }
-    attsync(cwd, &args)
+    attsync(cwd, &run_args(scenario, engine, out, sets))
 }
 
 /// An in-process run that must succeed.
 fn run(cwd: &Path, scenario: &Path, out: &Path, sets: &[&str]) {
     run_with(cwd, "in-process", scenario, out, sets).assert_ok();
-}
-
-fn read_summary(dir: &Path) -> serde_json::Value {
-    let text = fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    serde_json::from_str(&text).expect("summary.json is JSON")
 }
 
 fn bytes(file: &Path) -> Vec<u8> {
@@ -128,14 +59,6 @@ fn assert_same_results(a: &Path, b: &Path) {
             b.display()
         );
     }
-}
-
-/// Names of the entries of `dir` (hidden ones included).
-fn entries(dir: &Path) -> BTreeSet<String> {
-    fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect()
 }
 
 /// `scenario`'s text with `extra` appended, written to `dir/name`.
@@ -170,10 +93,10 @@ fn ideal_network_section_changes_nothing() {
     let tmp = tempfile::tempdir().unwrap();
     let cwd = tmp.path();
     let short = "simulation.duration=1";
-    for (scenario, tag) in [(TIMEVARYING, "tv"), (OBSERVERLESS, "ol")] {
+    for (scenario, tag) in [(PAPER, "tv"), (OBSERVERLESS, "ol")] {
         let plain = cwd.join(format!("{tag}-plain"));
         run(cwd, Path::new(scenario), &plain, &[short]);
-        assert_eq!(read_summary(&plain)["links"], serde_json::json!([]));
+        assert_eq!(summary(&plain)["links"], serde_json::json!([]));
 
         // An explicit ideal [network] section in the file.
         let file = variant(
@@ -185,7 +108,7 @@ fn ideal_network_section_changes_nothing() {
         let ideal = cwd.join(format!("{tag}-ideal"));
         run(cwd, &file, &ideal, &[short]);
         assert_same_results(&plain, &ideal);
-        let s = read_summary(&ideal);
+        let s = summary(&ideal);
         assert_eq!(s["links"], serde_json::json!([]), "no impaired link: {s:#}");
         assert_eq!(s["complete"], true);
 
@@ -209,7 +132,7 @@ fn ideal_network_section_changes_nothing() {
             &[short, "network.loss=0.0"],
         );
         assert_same_results(&plain, &lossless);
-        let links = link_counts(&read_summary(&lossless));
+        let links = link_counts(&summary(&lossless));
         assert_eq!(links.len(), 12, "2 leader links + 2 × 5 edges: {links:?}");
         for &(from, to, sent, delivered, lost) in &links {
             assert_eq!(sent, 4 * 1000, "{from} → {to}: every stage of 1000 steps");
@@ -247,7 +170,7 @@ fn observerless_paper_converges_with_50ms_delay_not_with_1s() {
                         &out,
                         &[&format!("network.delay={d}")],
                     );
-                    (d, read_summary(&out))
+                    (d, summary(&out))
                 })
             })
             .collect();
@@ -297,7 +220,7 @@ fn seeded_loss_is_reproducible_end_to_end() {
     let gilbert =
         "network.loss={ model = \"gilbert-elliott\", p_gb = 0.05, p_bg = 0.3, loss_bad = 0.9 }";
     for (scenario, loss, tag) in [
-        (TIMEVARYING, bernoulli.as_str(), "tv-b"),
+        (PAPER, bernoulli.as_str(), "tv-b"),
         (OBSERVERLESS, gilbert, "ol-ge"),
     ] {
         let go = |seed: u64, name: &str| {
@@ -319,7 +242,7 @@ fn seeded_loss_is_reproducible_end_to_end() {
         };
         let (a, b, c) = (go(5, "a"), go(5, "b"), go(6, "c"));
         assert_same_results(&a, &b);
-        let (sa, sb, sc) = (read_summary(&a), read_summary(&b), read_summary(&c));
+        let (sa, sb, sc) = (summary(&a), summary(&b), summary(&c));
         assert_eq!(link_counts(&sa), link_counts(&sb), "{tag}: same seed");
         assert_eq!(sa["links"], sb["links"], "{tag}: same ages of information");
         assert!(!same(&a, &c, "errors.csv"), "{tag}: another seed");
@@ -375,7 +298,7 @@ fn process_engine_delivers_the_same_impaired_values() {
     let cwd = tmp.path();
     let file = variant(
         cwd,
-        TIMEVARYING,
+        PAPER,
         "impaired.toml",
         "[network]\nseed = 11\ndelay = 0.002\njitter = 0.002\nloss = 0.2\n\
          [[network.link]]\nfrom = 0\nto = 1\ndelay = 0.005\nperiod = 0.004\n\
@@ -387,7 +310,7 @@ fn process_engine_delivers_the_same_impaired_values() {
     run_with(cwd, "processes", &file, &p, &sets).assert_ok();
     run_with(cwd, "in-process", &file, &i, &sets).assert_ok();
     assert_same_results(&p, &i);
-    let (sp, si) = (read_summary(&p), read_summary(&i));
+    let (sp, si) = (summary(&p), summary(&i));
     assert_eq!(sp["engine"], "processes");
     assert_eq!(sp["complete"], true, "{sp:#}");
     assert_eq!(link_counts(&sp), link_counts(&si));
@@ -513,7 +436,7 @@ fn sweep_network_delay_with_margin() {
     for r in &rows {
         assert_eq!(field(&header, r, "complete"), "true", "{r:?}");
         let run_dir = dir.join(field(&header, r, "run"));
-        let s = read_summary(&run_dir);
+        let s = summary(&run_dir);
         let err: f64 = field(&header, r, "final_max_att_err").parse().unwrap();
         assert_eq!(Some(err), s["max_final_att_err"].as_f64(), "{r:?}");
         assert_eq!(converged(r), err < 1e-3, "{r:?}");

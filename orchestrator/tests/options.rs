@@ -2,33 +2,16 @@
 //! message naming the option, and nothing written (no results directory, no
 //! staging directory, no node process: the checks come before the engine).
 
+mod common;
+
+use common::{PAPER, attsync};
 use std::fs;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-const PAPER: &str = "../scenarios/paper/timevarying.toml";
-
-fn scenario() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(PAPER)
-}
-
-/// Runs `attsync args…` in `cwd`; (exit code, stderr).
-fn attsync(cwd: &Path, args: &[&str]) -> (Option<i32>, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("attsync runs");
-    (
-        out.status.code(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 /// Asserts `args` exit 2 naming `option`, with nothing written in `cwd`.
 fn refused(args: &[&str], option: &str) {
     let tmp = tempfile::tempdir().expect("tempdir");
-    let (code, stderr) = attsync(tmp.path(), args);
+    let out = attsync(tmp.path(), args);
+    let (code, stderr) = (out.code, out.stderr);
     assert_eq!(code, Some(2), "{args:?}: {stderr}");
     assert!(stderr.contains(option), "{args:?}: {stderr}");
     let left: Vec<_> = fs::read_dir(tmp.path()).expect("dir").collect();
@@ -36,26 +19,18 @@ fn refused(args: &[&str], option: &str) {
 }
 
 fn run(engine: &str, extra: &[&str]) -> Vec<String> {
-    let s = scenario();
-    let mut v: Vec<String> = [
-        "run",
-        s.to_str().expect("utf-8"),
-        "--engine",
-        engine,
-        "--quiet",
-    ]
-    .iter()
-    .map(|s| (*s).to_string())
-    .collect();
+    let mut v: Vec<String> = ["run", PAPER, "--engine", engine, "--quiet"]
+        .iter()
+        .map(|s| (*s).to_string())
+        .collect();
     v.extend(extra.iter().map(|s| (*s).to_string()));
     v
 }
 
 fn sweep(extra: &[&str]) -> Vec<String> {
-    let s = scenario();
     let mut v: Vec<String> = [
         "sweep",
-        s.to_str().expect("utf-8"),
+        PAPER,
         "--param",
         "network.delay",
         "--values",
@@ -117,10 +92,9 @@ fn sweep_options_out_of_range_are_refused() {
 
 #[test]
 fn sweep_value_that_makes_an_invalid_scenario_is_refused_before_any_run() {
-    let s = scenario();
     let args = [
         "sweep",
-        s.to_str().expect("utf-8"),
+        PAPER,
         "--param",
         "network.delay",
         "--values",
@@ -161,9 +135,5 @@ fn gen_tree_options_are_checked() {
 
 #[test]
 fn check_node_config_of_no_node_is_refused() {
-    let s = scenario();
-    refused(
-        &["check", s.to_str().expect("utf-8"), "--node-config", "99"],
-        "--node-config",
-    );
+    refused(&["check", PAPER, "--node-config", "99"], "--node-config");
 }

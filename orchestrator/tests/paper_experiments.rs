@@ -16,18 +16,12 @@
 //! leaves it at a time set by round-off (NOTES.md), so its curve is excluded
 //! from the comparison after it escapes.
 
+mod common;
+
 use attitude::engine::InProcess;
 use attitude::metrics::errors;
-use attsync::scenario::{Loaded, load};
-use std::path::PathBuf;
-
-fn scenario(name: &str, set: &[&str]) -> Loaded {
-    let file = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios/paper")
-        .join(name);
-    let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
-    load(&file, &set).unwrap_or_else(|e| panic!("{e}"))
-}
+use attsync::scenario::Loaded;
+use common::load_paper;
 
 /// `(t, agent id, att_err, angvel_err)` at every output sample.
 fn error_curves(l: &Loaded) -> Vec<(f64, u32, f64, f64)> {
@@ -44,7 +38,7 @@ fn error_curves(l: &Loaded) -> Vec<(f64, u32, f64, f64)> {
 }
 
 fn assert_converges(name: &str) {
-    let l = scenario(name, &[]);
+    let l = load_paper(name, &[]);
     let curves = error_curves(&l);
     let n = l.resolved.network.agents.len();
     let last = &curves[curves.len() - n..];
@@ -60,17 +54,17 @@ fn assert_converges(name: &str) {
 
 #[test]
 fn scheme_1_time_varying_converges() {
-    assert_converges("timevarying.toml");
+    assert_converges("timevarying");
 }
 
 #[test]
 fn scheme_2_constant_observer_converges() {
-    assert_converges("constant-observer.toml");
+    assert_converges("constant-observer");
 }
 
 #[test]
 fn scheme_3_constant_observerless_converges() {
-    assert_converges("constant-observerless.toml");
+    assert_converges("constant-observerless");
 }
 
 /// Largest |difference| of att_err and angvel_err between two runs, over
@@ -95,18 +89,18 @@ fn max_diff(
 #[test]
 fn step_halving_converged_curves() {
     for (name, skip) in [
-        ("timevarying.toml", &[5u32][..]),
-        ("constant-observer.toml", &[][..]),
-        ("constant-observerless.toml", &[][..]),
+        ("timevarying", &[5u32][..]),
+        ("constant-observer", &[][..]),
+        ("constant-observerless", &[][..]),
     ] {
-        let h1 = error_curves(&scenario(name, &[]));
-        let h2 = error_curves(&scenario(name, &["simulation.dt=0.0005"]));
+        let h1 = error_curves(&load_paper(name, &[]));
+        let h2 = error_curves(&load_paper(name, &["simulation.dt=0.0005"]));
         let late = max_diff(&h1, &h2, 1.0, skip);
         assert!(
             late < 1e-8,
             "{name}: dt 1 ms vs 0.5 ms differ by {late:e} after 1 s"
         );
-        if name == "constant-observerless.toml" {
+        if name == "constant-observerless" {
             let all = max_diff(&h1, &h2, 0.0, skip);
             assert!(all < 1e-8, "{name}: dt 1 ms vs 0.5 ms differ by {all:e}");
         }
@@ -116,8 +110,8 @@ fn step_halving_converged_curves() {
 #[test]
 fn step_halving_shows_fourth_order_on_the_transient() {
     let run = |dt: &str| {
-        error_curves(&scenario(
-            "constant-observer.toml",
+        error_curves(&load_paper(
+            "constant-observer",
             &["simulation.duration=1", &format!("simulation.dt={dt}")],
         ))
     };

@@ -2,50 +2,32 @@
 //! back, and consistent with `errors.csv` (the attitude errors recomputed from
 //! the exported matrices match the reported ones).
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
 
-fn attsync() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_attsync"))
-}
+use common::{Out, attsync, paper, run_args};
+use std::ffi::OsStr;
+use std::path::Path;
 
-fn scenario(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios/paper")
-        .join(name)
+/// `attsync export STATES --csv`, in `cwd`.
+fn export_csv(cwd: &Path, states: &Path) -> Out {
+    let args = [
+        OsStr::new("export"),
+        states.as_os_str(),
+        OsStr::new("--csv"),
+    ];
+    attsync(cwd, &args)
 }
 
 #[test]
 fn export_matches_errors_csv() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    let st = attsync()
-        .args([
-            "run",
-            "--engine",
-            "in-process",
-            "--quiet",
-            "--set",
-            "simulation.duration=0.1",
-        ])
-        .arg(scenario("timevarying.toml"))
-        .arg("--out")
-        .arg(&out)
-        .status()
-        .unwrap();
-    assert!(st.success());
-    let exported = attsync()
-        .arg("export")
-        .arg(out.join("states.bin"))
-        .arg("--csv")
-        .output()
-        .unwrap();
-    assert!(
-        exported.status.success(),
-        "{}",
-        String::from_utf8_lossy(&exported.stderr)
-    );
-    let text = String::from_utf8(exported.stdout).unwrap();
+    let sets = ["simulation.duration=0.1"];
+    let run = run_args(paper("timevarying"), "in-process", &out, &sets);
+    attsync(dir.path(), &run).assert_ok();
+    let exported = export_csv(dir.path(), &out.join("states.bin"));
+    exported.assert_ok();
+    let text = exported.stdout;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(header.len(), 2 + 9 + 3 + 9 + 3 + 3);
@@ -84,35 +66,16 @@ fn mat(v: &[&str]) -> nalgebra::Matrix3<f64> {
 fn truncated_states_file_is_refused_with_its_name() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    assert!(
-        attsync()
-            .args([
-                "run",
-                "--engine",
-                "in-process",
-                "--quiet",
-                "--set",
-                "simulation.duration=0.05"
-            ])
-            .arg(scenario("constant-observerless.toml"))
-            .arg("--out")
-            .arg(&out)
-            .status()
-            .unwrap()
-            .success()
-    );
+    let sets = ["simulation.duration=0.05"];
+    let run = run_args(paper("constant-observerless"), "in-process", &out, &sets);
+    attsync(dir.path(), &run).assert_ok();
     let file = out.join("states.bin");
     let mut bytes = std::fs::read(&file).unwrap();
     bytes.truncate(bytes.len() - 7);
     std::fs::write(&file, bytes).unwrap();
-    let r = attsync()
-        .arg("export")
-        .arg(&file)
-        .arg("--csv")
-        .output()
-        .unwrap();
-    assert!(!r.status.success());
-    let err = String::from_utf8_lossy(&r.stderr);
+    let r = export_csv(dir.path(), &file);
+    assert_ne!(r.code, Some(0));
+    let err = &r.stderr;
     assert!(
         err.contains("states.bin") && err.contains("truncated"),
         "{err}"

@@ -9,17 +9,12 @@
 //! the estimated bound the in-process run stays finite, well above it
 //! diverges.
 
-use attitude::engine::InProcess;
-use attitude::network::Network;
+mod common;
+
 use attsync::options::StiffnessCheck;
 use attsync::scenario::{Loaded, ScenarioError, load, load_with};
-use std::path::PathBuf;
-
-fn paper(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios/paper")
-        .join(name)
-}
+use common::{attsync, paper, run_args, stays_finite};
+use std::path::Path;
 
 fn sets(s: &[&str]) -> Vec<String> {
     s.iter().map(|x| x.to_string()).collect()
@@ -31,7 +26,7 @@ const STIFF_SIGMA: &str = "scheme.observer.k_sigma=2000";
 
 /// The estimated largest stable step of `file` with `set` (not refused).
 fn dt_max(file: &str, set: &[&str]) -> f64 {
-    let l = load_with(&paper(file), &sets(set), StiffnessCheck::Warn).expect("valid");
+    let l = load_with(Path::new(&paper(file)), &sets(set), StiffnessCheck::Warn).expect("valid");
     l.resolved.stiffness.expect("agents").dt_max
 }
 
@@ -47,7 +42,7 @@ fn load_dt(
     s.push(format!("simulation.dt={dt:e}"));
     s.push(format!("simulation.duration={:e}", dt * f64::from(steps)));
     s.push(format!("output.sample_period={:e}", dt * 10.0));
-    load_with(&paper(file), &s, check)
+    load_with(Path::new(&paper(file)), &s, check)
 }
 
 /// As [`load_dt`], not refused.
@@ -55,27 +50,9 @@ fn with_dt(file: &str, set: &[&str], dt: f64, steps: u32) -> Loaded {
     load_dt(file, set, dt, steps, StiffnessCheck::Warn).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// Whether every state of the run stays finite and below 1e6 (a diverging
-/// RK4 mode grows by a factor > 1 per step: it passes 1e6 within the run).
-fn stays_finite(net: &Network) -> bool {
-    let mut ok = true;
-    // The divergence guard stops the run at the first state beyond its
-    // envelope: that is "not finite" here too.
-    let diverged = InProcess::new(net).run(|s| {
-        ok = s.agents.iter().all(|a| {
-            [a.w, a.w_hat, a.s_hat]
-                .iter()
-                .all(|v| v.iter().all(|x| x.is_finite() && x.abs() < 1e6))
-                && a.r.iter().chain(a.r_hat.iter()).all(|x| x.is_finite())
-        });
-        ok
-    });
-    ok && diverged.is_none()
-}
-
 #[test]
 fn a_stiff_scenario_is_refused_naming_dt_the_bound_and_a_step_that_works() {
-    let e = load(&paper("timevarying.toml"), &sets(&[STIFF_SIGMA])).unwrap_err();
+    let e = load(Path::new(&paper("timevarying")), &sets(&[STIFF_SIGMA])).unwrap_err();
     let ScenarioError::Invalid { issues, .. } = &e else {
         panic!("{e}")
     };
@@ -91,7 +68,11 @@ fn a_stiff_scenario_is_refused_naming_dt_the_bound_and_a_step_that_works() {
     assert!(i.reason.contains("fastest mode 8.5e3 s⁻¹"), "{i}");
     let fix = i.reason.split("--set ").nth(1).expect("a fix").to_string();
     assert_eq!(fix, "simulation.dt=0.00025");
-    let ok = load(&paper("timevarying.toml"), &sets(&[STIFF_SIGMA, &fix])).expect("the fix works");
+    let ok = load(
+        Path::new(&paper("timevarying")),
+        &sets(&[STIFF_SIGMA, &fix]),
+    )
+    .expect("the fix works");
     assert!(
         ok.resolved
             .warnings
@@ -103,7 +84,7 @@ fn a_stiff_scenario_is_refused_naming_dt_the_bound_and_a_step_that_works() {
 #[test]
 fn no_stiffness_check_turns_the_refusal_into_a_warning() {
     let l = load_with(
-        &paper("timevarying.toml"),
+        Path::new(&paper("timevarying")),
         &sets(&[STIFF_SIGMA]),
         StiffnessCheck::Warn,
     )
@@ -120,10 +101,10 @@ fn no_stiffness_check_turns_the_refusal_into_a_warning() {
 
 #[test]
 fn a_step_close_to_the_bound_is_warned_about_not_refused() {
-    let bound = dt_max("timevarying.toml", &[STIFF_SIGMA]);
+    let bound = dt_max("timevarying", &[STIFF_SIGMA]);
     let check = StiffnessCheck::Refuse;
     for f in [0.9, 1.9] {
-        let l = load_dt("timevarying.toml", &[STIFF_SIGMA], f * bound, 100, check)
+        let l = load_dt("timevarying", &[STIFF_SIGMA], f * bound, 100, check)
             .unwrap_or_else(|e| panic!("{f}·dt_max refused: {e}"));
         let w = l
             .resolved
@@ -133,8 +114,8 @@ fn a_step_close_to_the_bound_is_warned_about_not_refused() {
             .expect("a warning");
         assert!(w.reason.contains("close to RK4's stability limit"), "{w}");
     }
-    assert!(load_dt("timevarying.toml", &[STIFF_SIGMA], 2.1 * bound, 100, check).is_err());
-    let l = load_dt("timevarying.toml", &[STIFF_SIGMA], 0.7 * bound, 100, check).expect("valid");
+    assert!(load_dt("timevarying", &[STIFF_SIGMA], 2.1 * bound, 100, check).is_err());
+    let l = load_dt("timevarying", &[STIFF_SIGMA], 0.7 * bound, 100, check).expect("valid");
     assert!(
         l.resolved
             .warnings
@@ -145,12 +126,8 @@ fn a_step_close_to_the_bound_is_warned_about_not_refused() {
 
 #[test]
 fn the_paper_scenarios_have_a_wide_margin() {
-    for f in [
-        "timevarying.toml",
-        "constant-observer.toml",
-        "constant-observerless.toml",
-    ] {
-        let l = load(&paper(f), &[]).expect("valid");
+    for f in ["timevarying", "constant-observer", "constant-observerless"] {
+        let l = load(Path::new(&paper(f)), &[]).expect("valid");
         let est = l.resolved.stiffness.expect("agents");
         assert!(est.dt_max > 10.0 * l.resolved.network.dt, "{f}: {est:?}");
         assert!(
@@ -170,18 +147,10 @@ fn the_paper_scenarios_have_a_wide_margin() {
 #[test]
 fn just_below_the_bound_stays_finite_well_above_diverges() {
     let cases: [(&str, &str, f64); 4] = [
-        ("timevarying.toml", STIFF_SIGMA, 0.95),
-        ("timevarying.toml", "scheme.control.k_omega=2000", 0.95),
-        (
-            "constant-observer.toml",
-            "scheme.observer.k_omega=3000",
-            0.95,
-        ),
-        (
-            "constant-observerless.toml",
-            "scheme.control.k_r=3000",
-            0.95,
-        ),
+        ("timevarying", STIFF_SIGMA, 0.95),
+        ("timevarying", "scheme.control.k_omega=2000", 0.95),
+        ("constant-observer", "scheme.observer.k_omega=3000", 0.95),
+        ("constant-observerless", "scheme.control.k_r=3000", 0.95),
     ];
     for (file, set, below) in cases {
         let bound = dt_max(file, &[set]);
@@ -203,31 +172,23 @@ fn just_below_the_bound_stays_finite_well_above_diverges() {
 /// `run` through with a warning (the run then goes on, whatever it does).
 #[test]
 fn cli_refuses_a_stiff_scenario_unless_told_not_to() {
-    let bin = env!("CARGO_BIN_EXE_attsync");
-    let file = paper("timevarying.toml");
-    let set = ["--set", STIFF_SIGMA];
-    let out = std::process::Command::new(bin)
-        .arg("check")
-        .arg(&file)
-        .args(set)
-        .output()
-        .expect("runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{err}");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let file = paper("timevarying");
+    let check = ["check", &file, "--set", STIFF_SIGMA];
+    let out = attsync(dir.path(), &check);
+    let err = &out.stderr;
+    assert_eq!(out.code, Some(2), "{err}");
     assert!(
         err.contains("simulation.dt: dt = 0.001 s exceeds the largest stable step"),
         "{err}"
     );
     assert!(err.contains("try --set simulation.dt=0.00025"), "{err}");
-    let out = std::process::Command::new(bin)
-        .arg("check")
-        .arg(&file)
-        .args(set)
-        .arg("--no-stiffness-check")
-        .output()
-        .expect("runs");
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(out.status.code(), Some(0), "{text}");
+    let out = attsync(
+        dir.path(),
+        &[&check[..], &["--no-stiffness-check"]].concat(),
+    );
+    let text = &out.stdout;
+    assert_eq!(out.code, Some(0), "{text}");
     assert!(
         text.contains("largest stable dt 3.268e-4 s for dt = 0.001 s: margin dt_max/dt = 0.327"),
         "{text}"
@@ -236,25 +197,12 @@ fn cli_refuses_a_stiff_scenario_unless_told_not_to() {
         text.contains("(not refused: --no-stiffness-check)"),
         "{text}"
     );
-    let dir = tempfile::tempdir().expect("tempdir");
-    let out = std::process::Command::new(bin)
-        .arg("run")
-        .arg(&file)
-        .args(set)
-        .args([
-            "--set",
-            "simulation.duration=0.02",
-            "--engine",
-            "in-process",
-            "--quiet",
-        ])
-        .arg("--no-stiffness-check")
-        .arg("--out")
-        .arg(dir.path().join("r"))
-        .output()
-        .expect("runs");
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_ne!(out.status.code(), Some(2), "{err}");
+    let sets = [STIFF_SIGMA, "simulation.duration=0.02"];
+    let mut run = run_args(&file, "in-process", dir.path().join("r"), &sets);
+    run.push("--no-stiffness-check".into());
+    let out = attsync(dir.path(), &run);
+    let err = &out.stderr;
+    assert_ne!(out.code, Some(2), "{err}");
     assert!(
         err.contains("warning:") && err.contains("simulation.dt"),
         "{err}"

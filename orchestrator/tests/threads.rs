@@ -14,13 +14,15 @@
 //!   work done on the snapshot, for 1, 2, 3 and 7 threads alike;
 //! - `--threads 0` is refused with exit code 2, naming the option.
 
+mod common;
+
 use attitude::engine::InProcess;
 use attitude::link::LinkStats;
 use attitude::network::AgentState;
 use attitude::reference::LeaderState;
 use attsync::scenario::load;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use common::{PAPER, attsync, load_paper, run_args, summary};
+use std::path::PathBuf;
 
 /// Every sample's step and state bits, the peak torques and the link counters.
 type Run = (Vec<(u64, Vec<u64>)>, Vec<u64>, Vec<Vec<(u32, LinkStats)>>);
@@ -54,9 +56,7 @@ fn run_on(net: &attitude::network::Network, threads: usize) -> Run {
 #[test]
 fn paper_scenarios_are_bit_identical_on_1_2_3_and_7_threads() {
     for name in ["timevarying", "constant-observer", "constant-observerless"] {
-        let file = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("../scenarios/paper/{name}.toml"));
-        let loaded = load(&file, &["simulation.duration=1".into()]).expect("valid");
+        let loaded = load_paper(name, &["simulation.duration=1"]);
         let net = &loaded.resolved.network;
         let one = run_on(net, 1);
         assert_eq!(one.0.len(), 101, "{name}: samples every 10 ms over 1 s");
@@ -105,20 +105,6 @@ fn per_agent_work_at_samples_is_the_same_on_any_thread_count() {
     }
 }
 
-fn attsync(cwd: &Path, args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("attsync runs")
-}
-
-fn summary_threads(dir: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    let v: serde_json::Value = serde_json::from_str(&text).expect("json");
-    v["threads"].clone()
-}
-
 #[test]
 fn a_300_agent_tree_gives_byte_identical_results_for_any_thread_count() {
     tree_results_are_byte_identical_for_any_thread_count("observerless");
@@ -154,30 +140,15 @@ fn tree_results_are_byte_identical_for_any_thread_count(scheme: &str) {
             "tree.toml",
         ],
     );
-    assert!(
-        made.status.success(),
-        "{}",
-        String::from_utf8_lossy(&made.stderr)
-    );
+    made.assert_ok();
     let mut first: Option<(Vec<u8>, Vec<u8>)> = None;
     for (threads, used) in [("1", 1), ("2", 2), ("3", 3), ("7", 4)] {
         let out = format!("out-{threads}");
-        let args = [
-            "run",
-            "tree.toml",
-            "--engine",
-            "in-process",
-            "--quiet",
-            "--threads",
-        ];
-        let run = attsync(dir, &[&args[..], &[threads, "--out", &out]].concat());
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        let mut args = run_args("tree.toml", "in-process", &out, &[]);
+        args.extend(["--threads".into(), threads.into()]);
+        attsync(dir, &args).assert_ok();
         let out = dir.join(out);
-        assert_eq!(summary_threads(&out), serde_json::json!(used));
+        assert_eq!(summary(&out)["threads"], serde_json::json!(used));
         let files = (
             std::fs::read(out.join("errors.csv")).expect("errors.csv"),
             std::fs::read(out.join("states.bin")).expect("states.bin"),
@@ -193,10 +164,7 @@ fn tree_results_are_byte_identical_for_any_thread_count(scheme: &str) {
 #[test]
 fn zero_threads_are_refused_naming_the_option() {
     let tmp = tempfile::tempdir().expect("tempdir");
-    let paper = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../scenarios/paper/timevarying.toml"
-    );
+    let paper = PAPER;
     for cmd in [
         vec![
             "run",
@@ -220,8 +188,8 @@ fn zero_threads_are_refused_naming_the_option() {
         ],
     ] {
         let out = attsync(tmp.path(), &cmd);
-        assert_eq!(out.status.code(), Some(2), "{cmd:?}");
-        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.code, Some(2), "{cmd:?}");
+        let err = &out.stderr;
         assert!(err.contains("--threads 0: must be at least 1"), "{err}");
     }
     assert!(!tmp.path().join("o").exists());

@@ -14,36 +14,20 @@
 //! compact tree, no token or event vector): it reads what toml reads, the
 //! same `Scenario` and the same `scenario.toml` bytes, with `--set` too.
 
+mod common;
+
 use attsync::generate::{TreeParams, tree};
 use attsync::scenario::deserialize::{Kind, collect, deserialize};
 use attsync::scenario::schema::SchemeKind;
 use attsync::scenario::{ScenarioError, load_str, resolve::resolve};
+use common::PAPER;
 use std::path::Path;
-use std::process::Command;
 use toml::Table;
-
-const PAPER: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/timevarying.toml"
-);
 
 /// `attsync args…` in `cwd`; its stdout, after asserting success.
 #[track_caller]
 fn attsync_ok(cwd: &Path, args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("attsync starts");
-    let (stdout, stderr) = (
-        String::from_utf8(out.stdout).expect("UTF-8"),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    );
-    assert!(
-        out.status.success(),
-        "attsync {args:?} failed:\n{stdout}\n{stderr}"
-    );
-    stdout
+    common::attsync(cwd, args).assert_ok().stdout.clone()
 }
 
 /// `(count, λmin, λmax)` from `spectrum of Ξ + LLᵀ: N eigenvalues in [a, b]`.

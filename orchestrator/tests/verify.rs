@@ -15,64 +15,24 @@
 //!   SHA-256 that coreutils' `sha256sum` computes, and records the build,
 //!   the scenario's hash, the seeds, the engine and the platform.
 
+mod common;
+
+use common::{Out, PAPER, attsync, json, run_args};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const PAPER: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/timevarying.toml"
-);
-
-/// What a finished `attsync` process left.
-struct Out {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-impl Out {
-    #[track_caller]
-    fn assert_code(&self, code: i32) -> &Self {
-        assert_eq!(
-            self.code,
-            Some(code),
-            "--- stdout\n{}\n--- stderr\n{}",
-            self.stdout,
-            self.stderr
-        );
-        self
-    }
-}
-
-/// Runs `attsync args…` in `cwd`.
-fn attsync<S: AsRef<std::ffi::OsStr>>(cwd: &Path, args: &[S]) -> Out {
-    let out = Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .env_remove("ATTSYNC_LOG")
-        .output()
-        .expect("attsync starts");
-    Out {
-        code: out.status.code(),
-        stdout: String::from_utf8(out.stdout).expect("UTF-8 stdout"),
-        stderr: String::from_utf8(out.stderr).expect("UTF-8 stderr"),
-    }
-}
-
 /// `attsync run PAPER --engine in-process --out OUT --quiet --set …` (0.5 s
 /// unless `sets` say otherwise), expecting exit code `code`.
 fn run(cwd: &Path, out: &Path, sets: &[&str], code: i32) -> PathBuf {
-    let mut args: Vec<String> = ["run", PAPER, "--engine", "in-process", "--quiet", "--out"]
-        .map(String::from)
-        .to_vec();
-    args.push(out.display().to_string());
-    for s in ["simulation.duration=0.5"].iter().chain(sets) {
-        args.extend(["--set".into(), (*s).to_string()]);
-    }
-    attsync(cwd, &args).assert_code(code);
+    let sets: Vec<&str> = ["simulation.duration=0.5"]
+        .iter()
+        .chain(sets)
+        .copied()
+        .collect();
+    attsync(cwd, &run_args(PAPER, "in-process", out, &sets)).assert_code(code);
     out.to_owned()
 }
 
@@ -85,10 +45,6 @@ fn verify(cwd: &Path, dir: &Path, extra: &[&str]) -> Out {
     ];
     args.extend(extra.iter().map(|s| (*s).to_string()));
     attsync(cwd, &args)
-}
-
-fn json(file: &Path) -> Value {
-    serde_json::from_str(&fs::read_to_string(file).expect("readable")).expect("JSON")
 }
 
 #[test]
@@ -133,20 +89,8 @@ fn a_scenario_without_a_name_verifies_under_its_recorded_one() {
     let file = tmp.path().join("unnamed.toml");
     fs::write(&file, unnamed).unwrap();
     let out = tmp.path().join("out");
-    let args = [
-        "run",
-        file.to_str().unwrap(),
-        "--engine",
-        "in-process",
-        "--quiet",
-    ];
-    let set = [
-        "--set",
-        "simulation.duration=0.2",
-        "--out",
-        out.to_str().unwrap(),
-    ];
-    attsync(tmp.path(), &[&args[..], &set[..]].concat()).assert_code(0);
+    let args = run_args(&file, "in-process", &out, &["simulation.duration=0.2"]);
+    attsync(tmp.path(), &args).assert_code(0);
     assert_eq!(json(&out.join("manifest.json"))["scenario"], "unnamed");
     let v = verify(tmp.path(), &out, &[]);
     v.assert_code(0);

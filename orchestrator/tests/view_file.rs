@@ -6,51 +6,20 @@
 //! results; `errors.svg` has the observer's panels exactly where the scheme
 //! has an observer.
 
+mod common;
+
+use common::{OBSERVERLESS, PAPER, attsync, run_args};
 use std::fs;
 use std::path::Path;
-use std::process::{Command, Output};
 
-const TIMEVARYING: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/timevarying.toml"
-);
-const OBSERVERLESS: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../scenarios/paper/constant-observerless.toml"
-);
 const OBSERVER_CAPTION: &str = "observer attitude error";
 
-fn attsync(cwd: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_attsync"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("attsync starts")
-}
-
-#[track_caller]
-fn ok(out: &Output) {
-    assert!(
-        out.status.success(),
-        "attsync failed ({}):\n{}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
+/// `attsync run SCENARIO --engine in-process --out OUT --quiet EXTRA…`,
+/// which must succeed.
 fn run(cwd: &Path, scenario: &str, out: &str, extra: &[&str]) {
-    let mut args = vec![
-        "run",
-        scenario,
-        "--engine",
-        "in-process",
-        "--out",
-        out,
-        "--quiet",
-    ];
-    args.extend(extra);
-    ok(&attsync(cwd, &args));
+    let mut args = run_args(scenario, "in-process", out, &[]);
+    args.extend(extra.iter().map(Into::into));
+    attsync(cwd, &args).assert_ok();
 }
 
 /// The page's JSON data.
@@ -64,7 +33,7 @@ fn data(html: &str) -> serde_json::Value {
 #[test]
 fn the_paper_run_writes_a_small_self_contained_view_that_attsync_view_remakes() {
     let tmp = tempfile::tempdir().unwrap();
-    run(tmp.path(), TIMEVARYING, "tv", &[]);
+    run(tmp.path(), PAPER, "tv", &[]);
     let file = tmp.path().join("tv/view.html");
     let html = fs::read_to_string(&file).expect("view.html");
     assert!(html.len() < 5_000_000, "view.html is {} bytes", html.len());
@@ -111,8 +80,8 @@ fn the_paper_run_writes_a_small_self_contained_view_that_attsync_view_remakes() 
 
     fs::remove_file(&file).unwrap();
     let again = attsync(tmp.path(), &["view", "tv"]);
-    ok(&again);
-    assert!(String::from_utf8_lossy(&again.stdout).contains("view.html"));
+    again.assert_ok();
+    assert!(again.stdout.contains("view.html"));
     assert_eq!(
         fs::read_to_string(&file).unwrap(),
         html,
@@ -156,8 +125,8 @@ fn attsync_view_of_a_directory_that_is_no_run_names_the_missing_file() {
     let tmp = tempfile::tempdir().unwrap();
     fs::create_dir(tmp.path().join("empty")).unwrap();
     let out = attsync(tmp.path(), &["view", "empty"]);
-    assert_eq!(out.status.code(), Some(1));
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.code, Some(1));
+    let stderr = &out.stderr;
     assert!(stderr.contains("empty/scenario.toml"), "{stderr}");
     assert!(!tmp.path().join("empty/view.html").exists());
 }

@@ -15,36 +15,51 @@
 //! - `command.rs`: [`Attsync`], an `attsync` command line ([`run_args`] builds
 //!   the usual `run` arguments).
 //! - `running.rs`: [`Running`], a started `attsync`, waited for with a bound
-//!   ([`Running::wait`]) and killed together with its node processes if the
+//!   ([`Running::wait`]; [`Running::once_stepping`]: until a node steps)
+//!   and killed together with its node processes if the
 //!   test gives up on it; [`Finished`]: its exit status, output, the iceoryx2
 //!   runs it owned, and what it left behind ([`Finished::leftovers`]).
 //! - `namespace.rs`: run namespaces (`<tmp>/attsync-iox2/<run>/` with an
 //!   `owner` file holding the orchestrator's pid, shared memory
 //!   `/dev/shm/as<run>_*`): [`iox_base`], [`owned_runs`], [`run_leftovers`],
-//!   [`run_processes`], [`node_pid`]; [`signal`], [`kill9`].
+//!   [`run_processes`], [`node_pid`], [`owned_run`]; [`signal`], [`kill9`].
 //! - `results.rs`: [`read`], [`assert_same_file`], [`assert_same_bytes`],
 //!   [`csv_agents`], [`csv_rows`], [`summary`], [`summary_without`],
 //!   [`assert_same_results`], [`staging_dir`].
+//! - `conform.rs`: [`run_conform`] (`attsync conform` of a candidate),
+//!   [`rule_line`] (one rule's verdict in its report).
+//! - `python.rs`: [`require_iceoryx2_module`], [`conform_python`] (agents
+//!   written in Python).
+//! - `variant.rs`: scenario files edited for a test: [`with_agent_lines`]
+//!   (an agent given lines of its own), [`sh_plugin`], [`broken_agent`].
 //! - this file: [`wait_until`], [`RUN_TIMEOUT`].
 //!
 //! Every wait is bounded ([`wait_until`], [`RUN_TIMEOUT`]); nothing asserts
 //! wall-clock durations.
 
 mod command;
+mod conform;
 mod namespace;
+mod python;
 mod results;
 mod running;
 mod sandbox;
+mod variant;
 mod workspace;
 
 pub use command::{Attsync, run_args};
-pub use namespace::{iox_base, kill9, node_pid, owned_runs, run_leftovers, run_processes, signal};
+pub use conform::{rule_line, run_conform};
+pub use namespace::{
+    iox_base, kill9, node_pid, owned_run, owned_runs, run_leftovers, run_processes, signal,
+};
+pub use python::{conform_python, require_iceoryx2_module};
 pub use results::{
     assert_same_bytes, assert_same_file, assert_same_results, csv_agents, csv_rows, read,
     staging_dir, summary, summary_without,
 };
 pub use running::{Finished, Running};
 pub use sandbox::Sandbox;
+pub use variant::{broken_agent, sh_plugin, with_agent_lines};
 pub use workspace::{bin, bin_dir, copy_executable, paper, scenario};
 
 use std::time::{Duration, Instant};

@@ -63,6 +63,23 @@ pub fn owned_runs(pid: u32) -> Vec<String> {
         .collect()
 }
 
+/// The run whose `owner` file holds `pid` (see [`owned_runs`]), waited
+/// for at most 30 s (the orchestrator creates it as it starts); panics if
+/// none appears.
+#[must_use]
+pub fn owned_run(pid: u32) -> String {
+    let poll = std::time::Duration::from_millis(20);
+    crate::wait_until(std::time::Duration::from_secs(30), poll, || {
+        owned_runs(pid).into_iter().next()
+    })
+    .unwrap_or_else(|| {
+        panic!(
+            "no {}/*/owner holds attsync's pid {pid}",
+            iox_base().display()
+        )
+    })
+}
+
 /// What is left of run `run`: its root directory and its shared memory.
 #[must_use]
 pub fn run_leftovers(run: &str) -> Vec<PathBuf> {

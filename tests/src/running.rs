@@ -2,10 +2,12 @@
 //! processes if given up on) and what it left when it ended ([`Finished`]).
 
 use crate::namespace::{SHM_DIR, kill9, namespace_entries, owned_runs, run_processes};
+use crate::wait_until;
 use std::collections::BTreeSet;
+use std::fs;
 use std::io::Read;
 use std::os::unix::process::ExitStatusExt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, ExitStatus};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -78,6 +80,42 @@ impl Running {
     pub fn has_ended(&mut self) -> bool {
         let child = self.child.as_mut().expect("not yet waited");
         matches!(child.try_wait(), Ok(Some(_)))
+    }
+
+    /// Waits until node `node` of its run is stepping: `staging/logs/<node>.log`
+    /// says `started`, then the first rows of `staging/errors.csv` are
+    /// flushed (well into stepping), at most 60 s each. Panics saying which
+    /// did not happen, with its output if it ended first.
+    #[must_use]
+    pub fn once_stepping(mut self, staging: &Path, node: &str) -> Self {
+        let log = staging.join(format!("logs/{node}.log"));
+        let csv = staging.join("errors.csv");
+        let started = |p: &Path| fs::read_to_string(p).is_ok_and(|l| l.contains("started"));
+        let rows = |p: &Path| fs::metadata(p).is_ok_and(|m| m.len() > 0);
+        let stages: [(&Path, &str, &dyn Fn(&Path) -> bool); 2] = [
+            (&log, "said `started`", &started),
+            (&csv, "got its first rows", &rows),
+        ];
+        for (file, what, done) in stages {
+            let poll = Duration::from_millis(20);
+            let reached = wait_until(Duration::from_secs(60), poll, || {
+                (self.has_ended() || done(file)).then_some(())
+            });
+            if self.has_ended() {
+                let finished = self.wait(Duration::from_secs(10));
+                panic!(
+                    "attsync ended before {} {what}:\n{}",
+                    file.display(),
+                    finished.describe()
+                );
+            }
+            assert!(
+                reached.is_some(),
+                "{} never {what} within 60 s",
+                file.display()
+            );
+        }
+        self
     }
 
     /// Waits until it ends, at most `timeout`; past that, kills it and its

@@ -3,33 +3,18 @@
 //! broken ones (`tests/src/bin/broken_agent.rs`, fault from `ATTSYNC_FAULT`).
 //! Also: what the same faults do inside a real run.
 
-use attsync_tests::{Attsync, Finished, Sandbox, bin, paper, read, run_args, summary};
+use attsync_tests::{
+    Attsync, Finished, Sandbox, bin, broken_agent, paper, rule_line, run_args, run_conform,
+    summary, with_agent_lines,
+};
 
+/// `attsync conform -- PROGRAM` (a workspace binary) in a new sandbox
+/// named `test`, with `ATTSYNC_FAULT=fault` if given.
 fn conform(test: &str, program: &str, fault: Option<&str>) -> (Finished, Sandbox) {
     let tmp = Sandbox::new(test);
-    let mut a = Attsync::new(tmp.path())
-        .args(["conform", "--log"])
-        .args([tmp.join("candidate.log")]);
-    if let Some(f) = fault {
-        a = a.env("ATTSYNC_FAULT", f);
-    }
-    let r = a.args(["--".into(), bin(program)]).output();
+    let env: Vec<(&str, &str)> = fault.map(|f| ("ATTSYNC_FAULT", f)).into_iter().collect();
+    let r = run_conform(&tmp, &[], &[bin(program).into()], &env);
     (r, tmp)
-}
-
-/// The report line of `rule`, with its reason line(s).
-fn line<'a>(r: &'a Finished, rule: &str) -> &'a str {
-    let start = r
-        .stdout
-        .find(&format!("  {rule} "))
-        .unwrap_or_else(|| panic!("no rule {rule}:\n{}", r.describe()));
-    let start = r.stdout[..start].rfind('\n').map_or(0, |i| i + 1);
-    let end = r.stdout[start + 6..]
-        .find("\nPASS")
-        .or_else(|| r.stdout[start + 6..].find("\nFAIL"))
-        .or_else(|| r.stdout[start + 6..].find("\nSKIP"))
-        .map_or(r.stdout.len(), |e| start + 6 + e);
-    &r.stdout[start..end]
 }
 
 #[test]
@@ -43,11 +28,8 @@ fn the_builtin_agent_conforms() {
 fn the_saturated_rust_example_conforms() {
     // It saturates in the neighbourhood (τ_max = 5 N·m): its law is its own.
     let tmp = Sandbox::new("conform-saturated");
-    let r = Attsync::new(tmp.path())
-        .args(["conform", "--law", "own", "--log"])
-        .args([tmp.join("candidate.log")])
-        .args(["--".into(), bin("saturated-agent")])
-        .output();
+    let law = ["--law".into(), "own".into()];
+    let r = run_conform(&tmp, &law, &[bin("saturated-agent").into()], &[]);
     r.assert_ok();
     assert!(r.stdout.contains("9/9 rules pass"), "{}", r.describe());
 }
@@ -56,34 +38,42 @@ fn the_saturated_rust_example_conforms() {
 fn a_wrong_payload_type_fails_to_connect() {
     let (r, _t) = conform("conform-wrong-type", "broken_agent", Some("wrong-type"));
     r.assert_code(1);
-    let l = line(&r, "connects");
+    let l = rule_line(&r, "connects");
     assert!(
         l.starts_with("FAIL") && l.contains("IncompatibleTypes"),
         "{l}\n{}",
         r.describe()
     );
-    assert!(line(&r, "in-order").starts_with("SKIP"), "{}", r.describe());
-    assert!(line(&r, "version").starts_with("PASS"), "{}", r.describe());
+    assert!(
+        rule_line(&r, "in-order").starts_with("SKIP"),
+        "{}",
+        r.describe()
+    );
+    assert!(
+        rule_line(&r, "version").starts_with("PASS"),
+        "{}",
+        r.describe()
+    );
 }
 
 #[test]
 fn a_skipped_step_breaks_in_order() {
     let (r, _t) = conform("conform-skip-step", "broken_agent", Some("skip-step"));
     r.assert_code(1);
-    let l = line(&r, "in-order");
+    let l = rule_line(&r, "in-order");
     assert!(
         l.starts_with("FAIL") && l.contains("sent step 4 stage 0 where step 3 stage 0 was due"),
         "{l}\n{}",
         r.describe()
     );
-    assert!(line(&r, "connects").starts_with("PASS"));
+    assert!(rule_line(&r, "connects").starts_with("PASS"));
 }
 
 #[test]
 fn a_nan_state_is_not_valid() {
     let (r, _t) = conform("conform-nan", "broken_agent", Some("nan"));
     r.assert_code(1);
-    let l = line(&r, "valid-states");
+    let l = rule_line(&r, "valid-states");
     assert!(
         l.starts_with("FAIL") && l.contains("NaN"),
         "{l}\n{}",
@@ -96,7 +86,11 @@ fn a_nan_state_is_not_valid() {
         "stops",
         "clean",
     ] {
-        assert!(line(&r, ok).starts_with("PASS"), "{ok}\n{}", r.describe());
+        assert!(
+            rule_line(&r, ok).starts_with("PASS"),
+            "{ok}\n{}",
+            r.describe()
+        );
     }
 }
 
@@ -104,14 +98,14 @@ fn a_nan_state_is_not_valid() {
 fn an_agent_that_never_stops_fails_stops_and_is_killed() {
     let (r, _t) = conform("conform-never-stops", "broken_agent", Some("never-stops"));
     r.assert_code(1);
-    let l = line(&r, "stops");
+    let l = rule_line(&r, "stops");
     assert!(
         l.starts_with("FAIL") && l.contains("still running"),
         "{l}\n{}",
         r.describe()
     );
     assert!(
-        line(&r, "telemetry").starts_with("PASS"),
+        rule_line(&r, "telemetry").starts_with("PASS"),
         "{}",
         r.describe()
     );
@@ -120,15 +114,8 @@ fn an_agent_that_never_stops_fails_stops_and_is_killed() {
 
 /// The observerless paper scenario with agent 3 the broken agent.
 fn broken_scenario(tmp: &Sandbox, fault: &str) -> std::path::PathBuf {
-    let text = read(&paper("constant-observerless"));
-    let anchor = "[[agent]]\nid = 3\n";
-    let file = tmp.join("broken.toml");
-    let extra = format!(
-        "command = [{:?}]\nenv = {{ ATTSYNC_FAULT = {fault:?} }}\n",
-        bin("broken_agent").display().to_string()
-    );
-    std::fs::write(&file, text.replace(anchor, &format!("{anchor}{extra}"))).unwrap();
-    file
+    let base = paper("constant-observerless");
+    with_agent_lines(tmp, &base, 3, "broken", &broken_agent(fault))
 }
 
 #[test]

@@ -6,36 +6,13 @@
 //! example, saturating) fails it by default and is reported as INFO with
 //! `--law own`.
 
-use attsync_tests::{Attsync, Finished, Sandbox, bin, paper};
+use attsync_tests::{Finished, Sandbox, bin, paper, rule_line, run_conform};
 use std::ffi::OsString;
 
-/// `attsync conform ARGS… -- PROGRAM`, with `env`.
+/// `attsync conform ARGS… -- PROGRAM` (a workspace binary) in a new
+/// sandbox named `test`, with `env`.
 fn conform(test: &str, args: &[OsString], program: &str, env: &[(&str, &str)]) -> Finished {
-    let tmp = Sandbox::new(test);
-    let mut a = Attsync::new(tmp.path())
-        .args(["conform", "--log"])
-        .args([tmp.join("candidate.log")])
-        .args(args);
-    for (k, v) in env {
-        a = a.env(k, v);
-    }
-    a.args(["--".into(), bin(program)]).output()
-}
-
-/// The report line of `rule`, with its reason line(s).
-fn line<'a>(r: &'a Finished, rule: &str) -> &'a str {
-    let start = r
-        .stdout
-        .find(&format!("  {rule} "))
-        .unwrap_or_else(|| panic!("no rule {rule}:\n{}", r.describe()));
-    let start = r.stdout[..start].rfind('\n').map_or(0, |i| i + 1);
-    let rest = &r.stdout[start + 6..];
-    let end = ["\nPASS", "\nFAIL", "\nSKIP", "\nINFO"]
-        .iter()
-        .filter_map(|t| rest.find(t))
-        .min()
-        .map_or(r.stdout.len(), |e| start + 6 + e);
-    &r.stdout[start..end]
+    run_conform(&Sandbox::new(test), args, &[bin(program).into()], env)
 }
 
 /// The nine protocol rules.
@@ -63,55 +40,47 @@ fn paper_args(name: &str, id: &str) -> Vec<OsString> {
     v
 }
 
+/// `attsync conform` of the built-in agent as agent `id` of the paper's
+/// scenario `name`: it passes, rule `law` included.
+fn builtin_follows_the_law(test: &str, name: &str, id: &str) -> Finished {
+    let r = conform(test, &paper_args(name, id), "attsync-agent", &[]);
+    r.assert_ok();
+    assert!(rule_line(&r, "law").starts_with("PASS"), "{}", r.describe());
+    r
+}
+
 #[test]
 fn the_builtin_agent_follows_the_law_of_scheme_1() {
-    let r = conform(
-        "law-builtin-1",
-        &paper_args("timevarying", "1"),
-        "attsync-agent",
-        &[],
-    );
-    r.assert_ok();
-    assert!(line(&r, "law").starts_with("PASS"), "{}", r.describe());
+    let r = builtin_follows_the_law("law-builtin-1", "timevarying", "1");
     assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
 }
 
 #[test]
 fn the_builtin_agent_follows_the_law_of_scheme_2() {
-    let r = conform(
-        "law-builtin-2",
-        &paper_args("constant-observer", "2"),
-        "attsync-agent",
-        &[],
-    );
-    r.assert_ok();
-    assert!(line(&r, "law").starts_with("PASS"), "{}", r.describe());
+    builtin_follows_the_law("law-builtin-2", "constant-observer", "2");
 }
 
 #[test]
 fn the_builtin_agent_follows_the_law_of_scheme_3() {
-    let r = conform(
-        "law-builtin-3",
-        &paper_args("constant-observerless", "3"),
-        "attsync-agent",
-        &[],
-    );
-    r.assert_ok();
-    assert!(line(&r, "law").starts_with("PASS"), "{}", r.describe());
+    builtin_follows_the_law("law-builtin-3", "constant-observerless", "3");
 }
 
 #[test]
 fn a_wrong_sign_passes_the_protocol_and_fails_the_law() {
     let r = conform("law-wrong-sign", &[], "wrong_sign_agent", &[]);
     r.assert_code(1);
-    let l = line(&r, "law");
+    let l = rule_line(&r, "law");
     assert!(
         l.starts_with("FAIL") && l.contains("differs from the built-in scheme-3 law by"),
         "{l}\n{}",
         r.describe()
     );
     for ok in PROTOCOL_RULES {
-        assert!(line(&r, ok).starts_with("PASS"), "{ok}\n{}", r.describe());
+        assert!(
+            rule_line(&r, ok).starts_with("PASS"),
+            "{ok}\n{}",
+            r.describe()
+        );
     }
     assert!(r.stdout.contains("9/10 rules pass"), "{}", r.describe());
 }
@@ -125,7 +94,7 @@ fn a_wrong_sign_under_an_observer_scheme_shows_in_the_samples() {
         &[],
     );
     r.assert_code(1);
-    let l = line(&r, "law");
+    let l = rule_line(&r, "law");
     assert!(
         l.starts_with("FAIL") && l.contains("differs from the built-in scheme-1 law by"),
         "{l}\n{}",
@@ -139,7 +108,7 @@ const SATURATING: [(&str, &str); 1] = [("SATURATED_TAU_MAX", "1.0")];
 fn a_saturated_controller_fails_the_builtin_law() {
     let r = conform("law-saturated", &[], "saturated-agent", &SATURATING);
     r.assert_code(1);
-    let l = line(&r, "law");
+    let l = rule_line(&r, "law");
     assert!(
         l.starts_with("FAIL") && l.contains("differs from the built-in scheme-3 law by"),
         "{l}\n{}",
@@ -156,7 +125,7 @@ fn a_saturated_controller_of_its_own_is_information_only() {
         &SATURATING,
     );
     r.assert_ok();
-    let l = line(&r, "law");
+    let l = rule_line(&r, "law");
     assert!(
         l.starts_with("INFO") && l.contains("differs from the built-in scheme-3 law by"),
         "{l}\n{}",

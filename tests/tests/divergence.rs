@@ -10,7 +10,10 @@
 //! and no row of `errors.csv` invents an error (no `1` for a NaN state). A
 //! plug-in that reports garbage in its telemetry fails the run, named.
 
-use attsync_tests::{Attsync, Sandbox, assert_same_results, bin, paper, read, run_args, summary};
+use attsync_tests::{
+    Attsync, Finished, Sandbox, assert_same_results, broken_agent, paper, read, run_args, summary,
+    with_agent_lines,
+};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -167,31 +170,26 @@ fn the_generated_100_agent_tree_diverges_alike_in_both_engines() {
 /// The observerless paper scenario with agent 3 the fixture `broken_agent`
 /// injecting `fault`.
 fn with_broken_agent_3(tmp: &Sandbox, fault: &str) -> PathBuf {
-    let text = read(&paper("constant-observerless"));
-    let anchor = "[[agent]]\nid = 3\n";
-    assert!(text.contains(anchor), "agent 3 not found");
-    let command = format!(
-        "command = [{:?}]\nenv = {{ ATTSYNC_FAULT = {fault:?} }}\n",
-        bin("broken_agent").display().to_string()
-    );
-    let file = tmp.join(format!("{fault}.toml"));
-    std::fs::write(&file, text.replace(anchor, &format!("{anchor}{command}"))).unwrap();
-    file
+    let base = paper("constant-observerless");
+    with_agent_lines(tmp, &base, 3, fault, &broken_agent(fault))
+}
+
+/// Runs [`with_broken_agent_3`] (processes engine, 0.5 s) into `tmp/out`;
+/// the run and `out`.
+fn run_with_broken_agent_3(tmp: &Sandbox, fault: &str) -> (Finished, PathBuf) {
+    let scenario = with_broken_agent_3(tmp, fault);
+    let out = tmp.join("out");
+    let sets = ["simulation.duration=0.5"];
+    let r = Attsync::new(tmp.path())
+        .args(run_args(&scenario, "processes", &out, &sets))
+        .output();
+    (r, out)
 }
 
 #[test]
 fn a_plugin_reporting_nan_telemetry_diverges_named() {
     let tmp = Sandbox::new("nan-telemetry");
-    let scenario = with_broken_agent_3(&tmp, "nan-telemetry");
-    let out = tmp.join("out");
-    let r = Attsync::new(tmp.path())
-        .args(run_args(
-            &scenario,
-            "processes",
-            &out,
-            &["simulation.duration=0.5"],
-        ))
-        .output();
+    let (r, out) = run_with_broken_agent_3(&tmp, "nan-telemetry");
     r.assert_code(DIVERGED).assert_no_leftovers();
     let s = summary(&out);
     assert_eq!(s["complete"], false);
@@ -212,16 +210,7 @@ fn a_plugin_reporting_nan_telemetry_diverges_named() {
 #[test]
 fn a_plugin_reporting_a_non_rotation_breaks_the_protocol_named() {
     let tmp = Sandbox::new("bad-telemetry");
-    let scenario = with_broken_agent_3(&tmp, "bad-telemetry");
-    let out = tmp.join("out");
-    let r = Attsync::new(tmp.path())
-        .args(run_args(
-            &scenario,
-            "processes",
-            &out,
-            &["simulation.duration=0.5"],
-        ))
-        .output();
+    let (r, out) = run_with_broken_agent_3(&tmp, "bad-telemetry");
     r.assert_code(1).assert_no_leftovers();
     let s = summary(&out);
     assert_eq!(s["complete"], false);

@@ -3,18 +3,15 @@
 //! are not UTF-8 (its last lines are still shown), one whose child leaves
 //! the process group (killed at the end of the run: nothing survives it).
 
-use attsync_tests::{Attsync, Finished, Sandbox, paper, read, run_args, summary};
+use attsync_tests::{
+    Attsync, Finished, Sandbox, paper, run_args, sh_plugin, summary, with_agent_lines,
+};
 use std::path::{Path, PathBuf};
 
 /// The observerless paper scenario with agent 3 replaced by `sh -c SCRIPT`.
 fn with_plugin(tmp: &Sandbox, name: &str, script: &str) -> PathBuf {
-    let text = read(&paper("constant-observerless"));
-    let anchor = "[[agent]]\nid = 3\n";
-    assert!(text.contains(anchor), "agent 3 not found");
-    let extra = format!("command = [\"sh\", \"-c\", {script:?}]\n");
-    let file = tmp.join(format!("{name}.toml"));
-    std::fs::write(&file, text.replace(anchor, &format!("{anchor}{extra}"))).unwrap();
-    file
+    let base = paper("constant-observerless");
+    with_agent_lines(tmp, &base, 3, name, &sh_plugin(script))
 }
 
 /// Runs `scenario` (processes engine, 5 s, stage timeout 2 s) into `out`.

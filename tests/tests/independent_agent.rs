@@ -9,9 +9,11 @@
 //! README's test command and `.ci/run` do it); without the binding the
 //! tests fail saying so.
 
-use attsync_tests::{Attsync, Sandbox, assert_same_bytes, paper, run_args, summary};
+use attsync_tests::{
+    Attsync, Sandbox, assert_same_bytes, conform_python, paper, require_iceoryx2_module, run_args,
+    summary,
+};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// Simulated seconds per run: 5000 steps of the paper's dt = 1 ms, 20 000
 /// exchanges (the Python agent is slow; the built-in run is cut alike).
@@ -20,17 +22,6 @@ const DURATION: &str = "simulation.duration=5";
 fn agent_py() -> PathBuf {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("independent_agent/agent.py");
     p.canonicalize().expect("tests/independent_agent/agent.py")
-}
-
-fn require_iceoryx2_module() {
-    let ok = Command::new("python3")
-        .args(["-c", "import iceoryx2"])
-        .status()
-        .is_ok_and(|s| s.success());
-    assert!(
-        ok,
-        "python3 cannot import iceoryx2: run `python3 -m pip install -r examples/python/requirements.txt`"
-    );
 }
 
 /// `--set agent[k].command=["python3", "<abs>/agent.py"]` for the agents
@@ -140,14 +131,8 @@ fn sampled_coupling_is_bit_identical() {
 
 #[test]
 fn the_independent_agent_conforms() {
-    require_iceoryx2_module();
     let tmp = Sandbox::new("independent-conform");
-    let r = Attsync::new(tmp.path())
-        .args(["conform", "--log"])
-        .args([tmp.join("candidate.log")])
-        .args(["--", "python3"])
-        .args([agent_py()])
-        .output();
+    let r = conform_python(&tmp, &[], &agent_py());
     r.assert_ok();
     assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
 }

@@ -12,7 +12,9 @@
 //! root); where mounting is not allowed, a file-size limit (`ulimit -f`,
 //! SIGXFSZ ignored: writes fail with EFBIG) stands in for it.
 
-use attsync_tests::{Attsync, Finished, Sandbox, bin, paper, read, run_args};
+use attsync_tests::{
+    Attsync, Finished, Sandbox, bin, paper, run_args, sh_plugin, with_agent_lines,
+};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -130,6 +132,17 @@ fn with_small_disk(
     (r, left)
 }
 
+/// Neither the results nor their staging directory are left half-written:
+/// `left` (the entries beside `--out`) holds at most the lock file.
+#[track_caller]
+fn assert_no_results_left(left: &[String], r: &Finished) {
+    let stray: Vec<&String> = left
+        .iter()
+        .filter(|n| !n.starts_with(".out.lock"))
+        .collect();
+    assert!(stray.is_empty(), "left behind: {stray:?}\n{}", r.describe());
+}
+
 #[test]
 fn a_full_disk_names_the_results_file_and_leaves_no_results() {
     let tmp = Sandbox::new("limits-full-results");
@@ -151,43 +164,28 @@ fn a_full_disk_names_the_results_file_and_leaves_no_results() {
     for raw in ["Io {", "inner:", "kind:"] {
         assert!(!r.stderr.contains(raw), "a debug struct: {}", r.describe());
     }
-    // Neither the results nor their staging directory are left half-written.
-    let stray: Vec<&String> = left
-        .iter()
-        .filter(|n| !n.starts_with(".out.lock"))
-        .collect();
-    assert!(stray.is_empty(), "left behind: {stray:?}\n{}", r.describe());
+    assert_no_results_left(&left, &r);
 }
 
 #[test]
 fn a_full_disk_names_the_node_log_and_its_node() {
     let tmp = Sandbox::new("limits-full-log");
-    let text = read(&paper("constant-observerless"));
-    let anchor = "[[agent]]\nid = 3\n";
-    let flood = "command = [\"sh\", \"-c\", \"yes spam | head -c 4000000; exit 3\"]\n";
-    let file = tmp.join("flood.toml");
-    std::fs::write(&file, text.replace(anchor, &format!("{anchor}{flood}"))).unwrap();
+    let flood = sh_plugin("yes spam | head -c 4000000; exit 3");
+    let file = with_agent_lines(&tmp, &paper("constant-observerless"), 3, "flood", &flood);
     let (r, left) = with_small_disk(&tmp, 1024, "processes", &file, &["simulation.duration=5"]);
     r.assert_code(1).assert_no_leftovers();
     let line = (r.stderr.lines())
         .find(|l| l.contains("logs/agent-3.log: "))
         .unwrap_or_else(|| panic!("the log is not named: {}", r.describe()));
     assert!(line.contains("the log of agent-3 stops here"), "{line}");
-    let stray: Vec<&String> = left
-        .iter()
-        .filter(|n| !n.starts_with(".out.lock"))
-        .collect();
-    assert!(stray.is_empty(), "left behind: {stray:?}\n{}", r.describe());
+    assert_no_results_left(&left, &r);
 }
 
 #[test]
 fn a_start_up_timeout_names_the_silent_plugin_not_its_neighbours() {
     let tmp = Sandbox::new("limits-silent");
-    let text = read(&paper("constant-observerless"));
-    let anchor = "[[agent]]\nid = 3\n";
-    let silent = "command = [\"sh\", \"-c\", \"sleep 60\"]\n";
-    let file = tmp.join("silent.toml");
-    std::fs::write(&file, text.replace(anchor, &format!("{anchor}{silent}"))).unwrap();
+    let silent = sh_plugin("sleep 60");
+    let file = with_agent_lines(&tmp, &paper("constant-observerless"), 3, "silent", &silent);
     // `attsync run` waits the default start-up timeout (30 s).
     let args = run_args(
         &file,

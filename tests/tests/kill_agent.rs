@@ -21,8 +21,8 @@
 //! failure message points to exists.
 
 use attsync_tests::{
-    Attsync, Finished, Sandbox, csv_agents, csv_rows, iox_base, kill9, node_pid, owned_runs, paper,
-    read, run_args, run_leftovers, run_processes, staging_dir, summary, wait_until,
+    Attsync, Finished, Sandbox, csv_agents, csv_rows, kill9, node_pid, owned_run, paper, read,
+    run_args, run_leftovers, run_processes, staging_dir, summary, wait_until,
 };
 use serde_json::Value;
 use std::path::PathBuf;
@@ -42,7 +42,7 @@ struct Killed {
 fn kill_agent_3(test: &str) -> Killed {
     let tmp = Sandbox::new(test);
     let out = tmp.join("results");
-    let mut running = Attsync::new(tmp.path())
+    let running = Attsync::new(tmp.path())
         .args(run_args(
             &paper("timevarying"),
             "processes",
@@ -52,46 +52,9 @@ fn kill_agent_3(test: &str) -> Killed {
         .spawn();
     let pid = running.pid();
     let staging = staging_dir(&out, pid);
-    let log = staging.join("logs/agent-3.log");
-
     // Wait until agent 3 is stepping (or attsync ended: then fail with its output).
-    let started = wait_until(Duration::from_secs(60), POLL, || {
-        if running.has_ended() {
-            return Some(false);
-        }
-        std::fs::read_to_string(&log)
-            .is_ok_and(|l| l.contains("started"))
-            .then_some(true)
-    });
-    match started {
-        Some(true) => {}
-        Some(false) => panic!(
-            "attsync ended before agent 3 started:\n{}",
-            running.wait(Duration::from_secs(10)).describe()
-        ),
-        None => panic!("{} never said `started` within 60 s", log.display()),
-    }
-    // And until the first rows of errors.csv are flushed: well into stepping.
-    let csv = staging.join("errors.csv");
-    let rows = wait_until(Duration::from_secs(60), POLL, || {
-        (running.has_ended() || std::fs::metadata(&csv).is_ok_and(|m| m.len() > 0)).then_some(())
-    });
-    assert!(rows.is_some(), "{} stayed empty for 60 s", csv.display());
-    if running.has_ended() {
-        panic!(
-            "attsync ended before agent 3 was killed:\n{}",
-            running.wait(Duration::from_secs(10)).describe()
-        );
-    }
-    let run = wait_until(Duration::from_secs(10), POLL, || {
-        owned_runs(pid).into_iter().next()
-    })
-    .unwrap_or_else(|| {
-        panic!(
-            "no {}/*/owner holds attsync's pid {pid}",
-            iox_base().display()
-        )
-    });
+    let running = running.once_stepping(&staging, "agent-3");
+    let run = owned_run(pid);
     let agent =
         wait_until(Duration::from_secs(10), POLL, || node_pid(&run, 3)).unwrap_or_else(|| {
             panic!(

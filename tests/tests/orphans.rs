@@ -13,21 +13,12 @@
 //! the time measured is printed).
 
 use attsync_tests::{
-    Attsync, Running, Sandbox, kill9, node_pid, owned_runs, paper, read, run_args, run_leftovers,
-    run_processes, staging_dir, wait_until,
+    Attsync, Running, Sandbox, kill9, node_pid, owned_run, paper, run_args, run_leftovers,
+    run_processes, staging_dir, wait_until, with_agent_lines,
 };
-use std::path::Path;
 use std::time::{Duration, Instant};
 
 const POLL: Duration = Duration::from_millis(20);
-
-/// The run id of `attsync` (pid `pid`).
-fn run_of(pid: u32) -> String {
-    wait_until(Duration::from_secs(30), POLL, || {
-        owned_runs(pid).into_iter().next()
-    })
-    .unwrap_or_else(|| panic!("no run directory owned by attsync's pid {pid}"))
-}
 
 /// Pids of the node processes `ids` of run `run` that are alive.
 fn alive(run: &str, ids: &[u32]) -> Vec<(u32, u32)> {
@@ -71,17 +62,14 @@ fn kill_orchestrator_and_check(mut running: Running, run: &str, ids: &[u32]) {
 #[test]
 fn nodes_exit_when_the_orchestrator_dies_while_they_connect() {
     let tmp = Sandbox::new("orphans-connecting");
-    let text = read(&paper("timevarying"));
-    let anchor = "[[agent]]\nid = 3\n";
-    let file = tmp.join("never-connects.toml");
     // (`sh -c` ignores the `--config FILE` appended to a plug-in's command.)
     let extra = "command = [\"sh\", \"-c\", \"sleep 30\", \"never-connects\"]\n";
-    std::fs::write(&file, text.replace(anchor, &format!("{anchor}{extra}"))).unwrap();
+    let file = with_agent_lines(&tmp, &paper("timevarying"), 3, "never-connects", extra);
     let out = tmp.join("results");
     let running = Attsync::new(tmp.path())
         .args(run_args(&file, "processes", &out, &[]))
         .spawn();
-    let run = run_of(running.pid());
+    let run = owned_run(running.pid());
     let nodes = [0, 1, 2, 4, 5, 6, 7];
     let all = wait_until(Duration::from_secs(30), POLL, || {
         (alive(&run, &nodes).len() == nodes.len()).then_some(())
@@ -102,7 +90,7 @@ fn nodes_exit_when_the_orchestrator_dies_while_they_connect() {
 fn nodes_exit_when_the_orchestrator_dies_while_they_step() {
     let tmp = Sandbox::new("orphans-stepping");
     let out = tmp.join("results");
-    let mut running = Attsync::new(tmp.path())
+    let running = Attsync::new(tmp.path())
         .args(run_args(
             &paper("timevarying"),
             "processes",
@@ -111,19 +99,8 @@ fn nodes_exit_when_the_orchestrator_dies_while_they_step() {
         ))
         .spawn();
     let staging = staging_dir(&out, running.pid());
-    let stepping = |log: &Path, csv: &Path| {
-        std::fs::read_to_string(log).is_ok_and(|l| l.contains("started"))
-            && std::fs::metadata(csv).is_ok_and(|m| m.len() > 0)
-    };
-    let (log, csv) = (staging.join("logs/agent-3.log"), staging.join("errors.csv"));
-    let started = wait_until(Duration::from_secs(60), POLL, || {
-        (running.has_ended() || stepping(&log, &csv)).then_some(())
-    });
-    assert!(
-        started.is_some() && !running.has_ended(),
-        "the run never stepped"
-    );
-    let run = run_of(running.pid());
+    let running = running.once_stepping(&staging, "agent-3");
+    let run = owned_run(running.pid());
     let nodes: Vec<u32> = (0..=7).collect();
     assert_eq!(alive(&run, &nodes).len(), nodes.len(), "a node ended early");
     kill_orchestrator_and_check(running, &run, &nodes);

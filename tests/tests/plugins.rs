@@ -3,17 +3,14 @@
 
 use attsync_tests::{
     Attsync, Sandbox, assert_same_bytes, bin, paper, read, run_args, run_processes, summary,
+    with_agent_lines,
 };
 use std::path::{Path, PathBuf};
 
 /// The observerless paper scenario with `extra` TOML lines added to agent 3.
 fn with_agent_3(tmp: &Sandbox, name: &str, extra: &str) -> PathBuf {
-    let text = read(&paper("constant-observerless"));
-    let anchor = "[[agent]]\nid = 3\n";
-    assert!(text.contains(anchor), "agent 3 not found");
-    let file = tmp.join(format!("{name}.toml"));
-    std::fs::write(&file, text.replace(anchor, &format!("{anchor}{extra}\n"))).unwrap();
-    file
+    let base = paper("constant-observerless");
+    with_agent_lines(tmp, &base, 3, name, &format!("{extra}\n"))
 }
 
 fn toml_str(p: &Path) -> String {

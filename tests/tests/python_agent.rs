@@ -10,37 +10,20 @@
 //! README's test command and `.ci/run` do it).
 
 use attsync_tests::{
-    Attsync, Sandbox, assert_same_bytes, assert_same_file, paper, run_args, scenario, summary,
+    Attsync, Sandbox, assert_same_bytes, assert_same_file, conform_python, paper,
+    require_iceoryx2_module, run_args, scenario, summary,
 };
 use std::path::PathBuf;
-use std::process::Command;
 
 fn agent_py() -> PathBuf {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/python/agent.py");
     p.canonicalize().expect("examples/python/agent.py")
 }
 
-fn require_iceoryx2_module() {
-    let ok = Command::new("python3")
-        .args(["-c", "import iceoryx2"])
-        .status()
-        .is_ok_and(|s| s.success());
-    assert!(
-        ok,
-        "python3 cannot import iceoryx2: run `python3 -m pip install -r examples/python/requirements.txt`"
-    );
-}
-
 #[test]
 fn the_python_agent_conforms() {
-    require_iceoryx2_module();
     let tmp = Sandbox::new("python-conform");
-    let r = Attsync::new(tmp.path())
-        .args(["conform", "--log"])
-        .args([tmp.join("candidate.log")])
-        .args(["--", "python3"])
-        .args([agent_py()])
-        .output();
+    let r = conform_python(&tmp, &[], &agent_py());
     r.assert_ok();
     assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
 }
@@ -101,16 +84,9 @@ fn the_paper_experiment_converges_with_a_python_agent() {
 /// `attsync conform` with the candidate (agent 2) in the neighbourhood
 /// `scenarios/plugin/<neighbourhood>.toml`.
 fn conforms_in(neighbourhood: &str) {
-    require_iceoryx2_module();
     let tmp = Sandbox::new(neighbourhood);
-    let r = Attsync::new(tmp.path())
-        .args(["conform", "--scenario"])
-        .args([scenario(&format!("plugin/{neighbourhood}.toml"))])
-        .args(["--log"])
-        .args([tmp.join("candidate.log")])
-        .args(["--", "python3"])
-        .args([agent_py()])
-        .output();
+    let file = scenario(&format!("plugin/{neighbourhood}.toml"));
+    let r = conform_python(&tmp, &["--scenario".into(), file.into()], &agent_py());
     r.assert_ok();
     assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
 }

@@ -2,6 +2,7 @@
 //! the histogram of the final errors on a log scale.
 
 use super::outcome::TrialResult;
+use crate::results::plot::{bars, canvas, chart, legend, line};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -14,11 +15,7 @@ const FLOOR: f64 = 1e-16;
 
 /// Draws both panels into `file` (SVG).
 pub fn draw(file: &Path, title: &str, results: &[TrialResult]) -> Result<(), String> {
-    let root = SVGBackend::new(file, (1000, 900)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let root = root
-        .titled(title, ("sans-serif", 22))
-        .map_err(|e| e.to_string())?;
+    let root = canvas(file, (1000, 900), title)?;
     let (top, bottom) = root.split_vertically(440);
     ecdf(&top, results)?;
     histogram(&bottom, results)?;
@@ -43,14 +40,8 @@ fn ecdf<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let n = results.len().max(1);
     let t_end = results.iter().map(|r| r.t_end).fold(1e-9, f64::max);
-    let mut chart = ChartBuilder::on(area)
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .caption(
-            "fraction of trials settled (ECDF of settle times; never settled: not reached)",
-            ("sans-serif", 16),
-        )
+    let caption = "fraction of trials settled (ECDF of settle times; never settled: not reached)";
+    let mut chart = chart(area, caption, 60)
         .build_cartesian_2d(0.0..t_end, 0.0..1.0)
         .map_err(|e| e.to_string())?;
     chart
@@ -65,24 +56,14 @@ fn ecdf<DB: DrawingBackend>(
     for (label, pick, color) in curves {
         let mut times: Vec<f64> = results.iter().filter_map(pick).collect();
         times.sort_by(f64::total_cmp);
-        chart
-            .draw_series(LineSeries::new(
-                steps(&times, n, t_end),
-                color.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?
-            .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
-            });
+        line(
+            &mut chart,
+            steps(&times, n, t_end),
+            color.stroke_width(2),
+            label,
+        )?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::LowerRight)
-        .draw()
-        .map_err(|e| e.to_string())
+    legend(&mut chart, SeriesLabelPosition::LowerRight)
 }
 
 /// Counts of `log10(max(v, FLOOR))` in unit bins from `lo` (NaN: not counted).
@@ -103,14 +84,8 @@ fn histogram<DB: DrawingBackend>(
     let att = bins(results.iter().map(|r| r.final_max_att_err), lo, hi);
     let angvel = bins(results.iter().map(|r| r.final_max_angvel_err), lo, hi);
     let top = att.iter().chain(&angvel).copied().max().unwrap_or(1).max(1);
-    let mut chart = ChartBuilder::on(area)
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .caption(
-            "final max error over agents (histogram, log10 bins)",
-            ("sans-serif", 16),
-        )
+    let caption = "final max error over agents (histogram, log10 bins)";
+    let mut chart = chart(area, caption, 60)
         .build_cartesian_2d(f64::from(lo)..f64::from(hi), 0.0..f64::from(top) * 1.1)
         .map_err(|e| e.to_string())?;
     chart
@@ -124,24 +99,14 @@ fn histogram<DB: DrawingBackend>(
         ("angvel_err", &angvel, RED, 0.5),
     ];
     for (label, counts, color, off) in series {
-        let bars = counts.iter().enumerate().map(move |(k, &c)| {
+        let rects = counts.iter().enumerate().map(move |(k, &c)| {
             let x = f64::from(lo) + k as f64 + off;
             Rectangle::new(
                 [(x, 0.0), (x + 0.45, f64::from(c))],
                 color.mix(0.7).filled(),
             )
         });
-        chart
-            .draw_series(bars)
-            .map_err(|e| e.to_string())?
-            .label(label)
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], color.filled()));
+        bars(&mut chart, rects, label, color.filled(), 12)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(|e| e.to_string())
+    legend(&mut chart, SeriesLabelPosition::UpperLeft)
 }

@@ -4,6 +4,9 @@
 //! two more panels; in real-time runs, the age of information of every
 //! link (mean and largest, as `summary.json` `links[]` has them: the runs
 //! record no time series of it).
+//!
+//! Also the look every attsync chart shares (`errors.svg` here, `mc.svg` in
+//! `mc/plot.rs`): `canvas`, `chart`, `line`, `bars`, `legend`.
 
 use super::Series;
 use super::summary::LinkSummary;
@@ -34,11 +37,7 @@ pub fn draw(
 ) -> Result<(), String> {
     let observer = series.iter().any(|s| !s.obs_att.is_empty());
     let panels = 2 + if observer { 2 } else { 0 } + usize::from(!aoi.is_empty());
-    let root = SVGBackend::new(file, (1000, PANEL_HEIGHT * panels as u32)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let root = root
-        .titled(title, ("sans-serif", 22))
-        .map_err(|e| e.to_string())?;
+    let root = canvas(file, (1000, PANEL_HEIGHT * panels as u32), title)?;
     let areas = root.split_evenly((panels, 1));
     panel(&areas[0], "attitude error |R_i R_0^T|_I", series, |s| {
         &s.att
@@ -72,11 +71,7 @@ fn aoi_bars<DB: DrawingBackend>(
         .fold(0.0, f64::max)
         .max(1e-6)
         * 1.15;
-    let mut chart = ChartBuilder::on(area)
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .caption(AOI, ("sans-serif", 16))
+    let mut chart = chart(area, AOI, 70)
         .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top)
         .map_err(|e| e.to_string())?;
     let label = |x: &f64| {
@@ -94,29 +89,20 @@ fn aoi_bars<DB: DrawingBackend>(
         .y_desc("ms")
         .draw()
         .map_err(|e| e.to_string())?;
-    let bars = [
+    let kinds = [
         ("mean age", 0.0, Palette99::pick(0)),
         ("max age", 0.4, Palette99::pick(1)),
     ];
-    for (name, off, color) in bars {
+    for (name, off, color) in kinds {
         let color = color.to_rgba();
         let pick = |l: &LinkSummary| if off == 0.0 { l.aoi_mean } else { l.aoi_max };
-        chart
-            .draw_series(links.iter().enumerate().map(|(k, l)| {
-                let x = k as f64 - 0.4 + off;
-                Rectangle::new([(x, 0.0), (x + 0.4, ms(pick(l)))], color.filled())
-            }))
-            .map_err(|e| e.to_string())?
-            .label(name)
-            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], color.filled()));
+        let rects = links.iter().enumerate().map(|(k, l)| {
+            let x = k as f64 - 0.4 + off;
+            Rectangle::new([(x, 0.0), (x + 0.4, ms(pick(l)))], color.filled())
+        });
+        bars(&mut chart, rects, name, color.filled(), 16)?;
     }
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| e.to_string())
+    legend(&mut chart, SeriesLabelPosition::UpperRight)
 }
 
 fn panel<DB: DrawingBackend>(
@@ -141,11 +127,7 @@ fn panel<DB: DrawingBackend>(
     } else {
         (FLOOR, 1.0)
     };
-    let mut chart = ChartBuilder::on(area)
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .caption(label, ("sans-serif", 16))
+    let mut chart = chart(area, label, 70)
         .build_cartesian_2d(0.0..t_end, (lo..hi).log_scale())
         .map_err(|e| e.to_string())?;
     chart
@@ -156,23 +138,98 @@ fn panel<DB: DrawingBackend>(
         .map_err(|e| e.to_string())?;
     for (k, s) in series.iter().enumerate() {
         let color = Palette99::pick(k).to_rgba();
-        let ys = pick(s);
-        chart
-            .draw_series(LineSeries::new(
-                s.t.iter().zip(ys).map(|(&t, &y)| (t, y.max(FLOOR))),
-                color.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?
-            .label(format!("agent {}", s.id))
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
-            });
+        let points = s.t.iter().zip(pick(s)).map(|(&t, &y)| (t, y.max(FLOOR)));
+        let name = format!("agent {}", s.id);
+        line(&mut chart, points, color.stroke_width(2), name)?;
     }
+    legend(&mut chart, SeriesLabelPosition::UpperRight)
+}
+
+/// A white SVG canvas of `size` px written to `file`, titled `title`
+/// (sans-serif 22): the area under the title. Call `present` on it when
+/// everything is drawn.
+pub(crate) fn canvas<'a>(
+    file: &'a Path,
+    size: (u32, u32),
+    title: &str,
+) -> Result<DrawingArea<SVGBackend<'a>, Shift>, String> {
+    let root = SVGBackend::new(file, size).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.titled(title, ("sans-serif", 22))
+        .map_err(|e| e.to_string())
+}
+
+/// A chart on `area` captioned `caption` (sans-serif 16): 12 px margins,
+/// 40 px for the x labels, `y_labels` px for the y labels.
+pub(crate) fn chart<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    y_labels: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut b = ChartBuilder::on(area);
+    b.margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(y_labels)
+        .caption(caption, ("sans-serif", 16));
+    b
+}
+
+/// Draws `points` as a line in `style`, with a 16 px line of it beside
+/// `label` in the legend.
+pub(crate) fn line<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    style: ShapeStyle,
+    label: impl Into<String>,
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    chart
+        .draw_series(LineSeries::new(points, style))
+        .map_err(|e| e.to_string())?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+    Ok(())
+}
+
+/// Draws `rects`, with a box `width` px wide in `style` beside `label` in
+/// the legend.
+pub(crate) fn bars<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    rects: impl IntoIterator<Item = Rectangle<(f64, f64)>>,
+    label: &str,
+    style: ShapeStyle,
+    width: i32,
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    chart
+        .draw_series(rects)
+        .map_err(|e| e.to_string())?
+        .label(label)
+        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + width, y + 5)], style));
+    Ok(())
+}
+
+/// The legend of `chart`'s labelled series at `position`, on a white,
+/// black-bordered box.
+pub(crate) fn legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate,
+{
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        .position(position)
         .draw()
         .map_err(|e| e.to_string())
 }
