@@ -92,7 +92,7 @@ impl Running {
         let csv = staging.join("errors.csv");
         let started = |p: &Path| fs::read_to_string(p).is_ok_and(|l| l.contains("started"));
         let rows = |p: &Path| fs::metadata(p).is_ok_and(|m| m.len() > 0);
-        let stages: [(&Path, &str, &dyn Fn(&Path) -> bool); 2] = [
+        let stages: [Stage<'_>; 2] = [
             (&log, "said `started`", &started),
             (&csv, "got its first rows", &rows),
         ];
@@ -286,3 +286,7 @@ impl Finished {
         self
     }
 }
+
+/// One stage [`Running::once_stepping`] waits for: the file, what it shows
+/// when reached, and the test on the file.
+type Stage<'a> = (&'a Path, &'a str, &'a dyn Fn(&Path) -> bool);
