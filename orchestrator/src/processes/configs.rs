@@ -45,6 +45,13 @@ pub(super) fn plugin_of<'a>(
     plugins.iter().find(|p| p.agent == id)
 }
 
+/// How much longer than the orchestrator a node waits for connections and
+/// `Start`, s. The orchestrator starts its own wait only once every node is
+/// spawned, so with equal timeouts the first node spawned gave up first —
+/// and the run blamed it, a node left waiting, instead of the silent node
+/// the orchestrator names when its own timeout ends (it sees every node).
+pub const NODE_START_GRACE: f64 = 5.0;
+
 /// The per-node configurations of `net`.
 #[must_use]
 pub fn node_configs(
@@ -75,7 +82,7 @@ pub fn node_configs(
         limits,
         wait: opts.wait,
         stage_timeout: opts.stage_timeout,
-        start_timeout: opts.start_timeout,
+        start_timeout: opts.start_timeout + NODE_START_GRACE,
         realtime: opts.realtime,
         guard: net.guard,
         contention,
