@@ -41,15 +41,21 @@ fn machine_busy_ticks() -> Option<u64> {
     Some(f.iter().take(8).sum::<u64>() - f.get(3)? - f.get(4)?)
 }
 
-fn own_ticks() -> Option<u64> {
+/// The numeric fields of `/proc/self/stat` after the command name (which
+/// ends with ')'): element 0 is field 3, so utime, stime, cutime, cstime
+/// (fields 14..17) are elements 11..14.
+fn self_stat() -> Option<Vec<u64>> {
     let text = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which ends with ')'): utime is the 14th field.
     let rest = &text[text.rfind(')')? + 2..];
-    let f: Vec<u64> = rest
-        .split_whitespace()
-        .map(|x| x.parse().unwrap_or(0))
-        .collect();
-    // rest[0] is field 3; utime, stime, cutime, cstime are fields 14..17.
+    Some(
+        rest.split_whitespace()
+            .map(|x| x.parse().unwrap_or(0))
+            .collect(),
+    )
+}
+
+fn own_ticks() -> Option<u64> {
+    let f = self_stat()?;
     Some(f.get(11)? + f.get(12)? + f.get(13)? + f.get(14)?)
 }
 
@@ -57,12 +63,7 @@ fn own_ticks() -> Option<u64> {
 /// finished ones included), s; `/proc` resolution (10 ms).
 #[must_use]
 pub fn cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = &text[text.rfind(')')? + 2..];
-    let f: Vec<u64> = rest
-        .split_whitespace()
-        .map(|x| x.parse().unwrap_or(0))
-        .collect();
+    let f = self_stat()?;
     Some((f.get(11)? + f.get(12)?) as f64 / TICKS)
 }
 
