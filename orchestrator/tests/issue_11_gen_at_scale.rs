@@ -334,7 +334,7 @@ fn a_duration_check_would_refuse_is_refused_and_nothing_is_written() {
                 "t.toml",
             ],
         );
-        assert!(!out.status.success(), "--duration {duration}");
+        assert_eq!(out.status.code(), Some(2), "--duration {duration}");
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(
             stderr.contains("--duration")

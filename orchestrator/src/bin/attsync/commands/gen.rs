@@ -2,6 +2,7 @@
 
 use attsync::Error;
 use attsync::generate::{TreeParams, WriteError, tree, write_file};
+use attsync::options::OptionError;
 use attsync::scenario::schema::SchemeKind;
 use clap::{Subcommand, ValueEnum};
 use std::path::PathBuf;
@@ -77,7 +78,9 @@ pub fn exec(a: GenCmd) -> Result<(), Error> {
         duration,
     };
     attsync::options::tree(&p)?;
-    let g = tree(&p).map_err(Error::Generate)?;
+    // What `tree` refuses is the arguments (a duration `check` would
+    // refuse, a tree too large for any horizon): invalid input, exit 2.
+    let g = tree(&p).map_err(|e| Error::Options(OptionError::Conflict(e)))?;
     if let Some(w) = &g.warning {
         eprintln!("warning: {w}");
     }
