@@ -112,7 +112,8 @@ pub fn gamma_i_as_printed(
     e.v.cross(&(j * e.v)) - j * (e.r_bar.transpose() * w_hat_dot)
 }
 
-/// Observer-based tracking torque for a time-varying reference.
+/// Observer-based tracking torque for a time-varying reference, with the
+/// corrected `Σᵢ`, `Γᵢ` ([`ControlLaw::tau_control`] for either law).
 ///
 /// # Equation
 /// ```text
@@ -128,11 +129,12 @@ pub fn tau_control(
     e: &TrackingError,
     w_hat_dot: &Vector3<f64>,
 ) -> Vector3<f64> {
-    -sigma_i(inertia, e) * e.w_bar - gamma_i(inertia, e, w_hat_dot) - pd(g, a_bar, e)
+    ControlLaw::Corrected.tau_control(g, inertia, a_bar, e, w_hat_dot)
 }
 
 /// Observer-based torque without the passive `Σᵢ ω̄ᵢ` compensation (Remark
-/// `re1`; used with the constant-reference observer `16a`–`16b`).
+/// `re1`; used with the constant-reference observer `16a`–`16b`), with the
+/// corrected `Γᵢ` ([`ControlLaw::tau_control_constant_estimate`] for either law).
 ///
 /// # Equation
 /// ```text
@@ -146,55 +148,7 @@ pub fn tau_control_constant_estimate(
     e: &TrackingError,
     w_hat_dot: &Vector3<f64>,
 ) -> Vector3<f64> {
-    -gamma_i(inertia, e, w_hat_dot) - pd(g, a_bar, e)
-}
-
-/// Eq. `control` with `Σᵢ`, `Γᵢ` as printed ([`sigma_i_as_printed`],
-/// [`gamma_i_as_printed`]): the negative control of scheme 1.
-///
-/// # Equation
-/// ```text
-/// (control, as printed)  τᵢ = −Σᵢ ω̄ᵢ − Γᵢ − k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ
-/// ```
-/// # NOTE
-/// Known wrong (erratum 1 of `docs/paper.md`): the tracking error obeys
-/// `Jᵢ dω̄ᵢ/dt = −k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ − 2 ωᵢ × Jᵢ vᵢ` instead of eq.
-/// `controlerror2`, and the residual does not vanish while the reference
-/// rotates: the paper's scheme-1 experiment stalls near 1e-2.
-#[must_use]
-pub fn tau_control_as_printed(
-    g: &ControlGains,
-    inertia: &Inertia,
-    a_bar: &Matrix3<f64>,
-    e: &TrackingError,
-    w_hat_dot: &Vector3<f64>,
-) -> Vector3<f64> {
-    -sigma_i_as_printed(inertia, e) * e.w_bar
-        - gamma_i_as_printed(inertia, e, w_hat_dot)
-        - pd(g, a_bar, e)
-}
-
-/// Eq. `controlconstantestimate` with `Γᵢ` as printed
-/// ([`gamma_i_as_printed`]; the paper defines scheme 2's `Γᵢ` by eq.
-/// `gammai`): the negative control of scheme 2.
-///
-/// # Equation
-/// ```text
-/// (controlconstantestimate, as printed)  τᵢ = −Γᵢ − k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ
-/// ```
-/// # NOTE
-/// The tracking error gains `−2 vᵢ × Jᵢ vᵢ` over the corrected law; with a
-/// constant reference the observer's `ω̂ᵢ → 0`, so `vᵢ → 0` and the
-/// residual fades: unlike scheme 1, this one still converges.
-#[must_use]
-pub fn tau_control_constant_estimate_as_printed(
-    g: &ControlGains,
-    inertia: &Inertia,
-    a_bar: &Matrix3<f64>,
-    e: &TrackingError,
-    w_hat_dot: &Vector3<f64>,
-) -> Vector3<f64> {
-    -gamma_i_as_printed(inertia, e, w_hat_dot) - pd(g, a_bar, e)
+    ControlLaw::Corrected.tau_control_constant_estimate(g, inertia, a_bar, e, w_hat_dot)
 }
 
 /// Which signs of `Σᵢ` (eq. `sigmai`) and `Γᵢ` (eq. `gammai`) the
@@ -207,8 +161,14 @@ pub enum ControlLaw {
     /// eq. `control` gives eq. `controlerror2` exactly.
     #[default]
     Corrected,
-    /// The signs as the paper prints them, known wrong: a negative control
-    /// (scheme 1 stalls instead of converging).
+    /// The signs as the paper prints them, known wrong: a negative control.
+    /// Scheme 1's tracking error then obeys
+    /// `Jᵢ dω̄ᵢ/dt = −k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ − 2 ωᵢ × Jᵢ vᵢ` instead of eq.
+    /// `controlerror2`, and the residual does not vanish while the reference
+    /// rotates: the paper's scheme-1 experiment stalls near 1e-2. Scheme 2
+    /// (the paper defines its `Γᵢ` by eq. `gammai` too) gains
+    /// `−2 vᵢ × Jᵢ vᵢ`; with a constant reference `ω̂ᵢ → 0`, so `vᵢ → 0` and
+    /// the residual fades: it still converges.
     AsPrinted,
 }
 
@@ -229,8 +189,35 @@ impl ControlLaw {
         }
     }
 
-    /// Scheme 1's torque under this law: [`tau_control`] or
-    /// [`tau_control_as_printed`].
+    /// `Σᵢ` under this law: [`sigma_i`] or [`sigma_i_as_printed`].
+    #[must_use]
+    pub fn sigma_i(self, inertia: &Inertia, e: &TrackingError) -> Matrix3<f64> {
+        match self {
+            ControlLaw::Corrected => sigma_i(inertia, e),
+            ControlLaw::AsPrinted => sigma_i_as_printed(inertia, e),
+        }
+    }
+
+    /// `Γᵢ` under this law: [`gamma_i`] or [`gamma_i_as_printed`].
+    #[must_use]
+    pub fn gamma_i(
+        self,
+        inertia: &Inertia,
+        e: &TrackingError,
+        w_hat_dot: &Vector3<f64>,
+    ) -> Vector3<f64> {
+        match self {
+            ControlLaw::Corrected => gamma_i(inertia, e, w_hat_dot),
+            ControlLaw::AsPrinted => gamma_i_as_printed(inertia, e, w_hat_dot),
+        }
+    }
+
+    /// Scheme 1's torque with this law's `Σᵢ`, `Γᵢ`.
+    ///
+    /// # Equation
+    /// ```text
+    /// (control)  τᵢ = −Σᵢ ω̄ᵢ − Γᵢ − k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ
+    /// ```
     #[must_use]
     pub fn tau_control(
         self,
@@ -240,14 +227,15 @@ impl ControlLaw {
         e: &TrackingError,
         w_hat_dot: &Vector3<f64>,
     ) -> Vector3<f64> {
-        match self {
-            ControlLaw::Corrected => tau_control(g, inertia, a_bar, e, w_hat_dot),
-            ControlLaw::AsPrinted => tau_control_as_printed(g, inertia, a_bar, e, w_hat_dot),
-        }
+        -self.sigma_i(inertia, e) * e.w_bar - self.gamma_i(inertia, e, w_hat_dot) - pd(g, a_bar, e)
     }
 
-    /// Scheme 2's torque under this law: [`tau_control_constant_estimate`]
-    /// or [`tau_control_constant_estimate_as_printed`].
+    /// Scheme 2's torque with this law's `Γᵢ`.
+    ///
+    /// # Equation
+    /// ```text
+    /// (controlconstantestimate)  τᵢ = −Γᵢ − k_R̄ ψ(Āᵢ R̄ᵢ) − k_ω̄ ω̄ᵢ
+    /// ```
     #[must_use]
     pub fn tau_control_constant_estimate(
         self,
@@ -257,12 +245,7 @@ impl ControlLaw {
         e: &TrackingError,
         w_hat_dot: &Vector3<f64>,
     ) -> Vector3<f64> {
-        match self {
-            ControlLaw::Corrected => tau_control_constant_estimate(g, inertia, a_bar, e, w_hat_dot),
-            ControlLaw::AsPrinted => {
-                tau_control_constant_estimate_as_printed(g, inertia, a_bar, e, w_hat_dot)
-            }
-        }
+        -self.gamma_i(inertia, e, w_hat_dot) - pd(g, a_bar, e)
     }
 }
 
