@@ -105,7 +105,8 @@ fn header(w: &mut String, o: &Options, plan: &Plan, cx: &Context) {
         w,
         "- times: **wall** = around the whole `attsync run` command, measured by the benchmark (process start, validation, \
          spawning and connecting the nodes, the run, writing results); **run** = `summary.json` `wall_seconds` \
-         (for the process engine: from before spawning the nodes to the last telemetry, so it includes start-up); \
+         (for the process engine: from opening the run's ports to the nodes' shutdown, so it includes start-up); \
+         **run − lockstep, ms per node** = the process engine's start-up (ports, spawning, connecting) and shutdown, per node; \
          **lockstep** = first node's `started_unix_ns` to last node's `done_unix_ns` in `summary.json` `nodes` \
          (the steady state, no start-up; peak RSS from the same entries); \
          the bare ring's time is measured the same way (first loop start to last loop end). \
@@ -142,6 +143,13 @@ fn inproc(w: &mut String, res: &Results, notes: &mut Vec<String>) {
     let _ = writeln!(w);
 }
 
+/// The process engine's own time outside the lockstep (spawning and
+/// connecting the nodes, shutting them down), per node, ms.
+fn per_node_ms(run: Option<f64>, lockstep: Option<f64>, nodes: u32) -> Option<f64> {
+    run.zip(lockstep)
+        .map(|(r, l)| (r - l) * 1e3 / f64::from(nodes.max(1)))
+}
+
 fn procs(w: &mut String, res: &Results, notes: &mut Vec<String>) {
     let _ = writeln!(
         w,
@@ -149,11 +157,11 @@ fn procs(w: &mut String, res: &Results, notes: &mut Vec<String>) {
     );
     let _ = writeln!(
         w,
-        "| case | nodes | wait | steps | wall s | real-time factor (wall) | run s | lockstep s | wall − lockstep s | steps/s (lockstep) | ring steps/s | attsync ÷ ring (lockstep) | attsync ÷ ring (wall) | agent peak RSS max / median kB | bg load |"
+        "| case | nodes | wait | steps | wall s | real-time factor (wall) | run s | lockstep s | wall − lockstep s | run − lockstep, ms per node | steps/s (lockstep) | ring steps/s | attsync ÷ ring (lockstep) | attsync ÷ ring (wall) | agent peak RSS max / median kB | bg load |"
     );
     let _ = writeln!(
         w,
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for p in &res.procs {
         let c = &res.cases[p.case];
@@ -165,7 +173,7 @@ fn procs(w: &mut String, res: &Results, notes: &mut Vec<String>) {
         let ratio = |x: Option<f64>| x.zip(ring_rate).map(|(a, b)| a / b);
         let _ = writeln!(
             w,
-            "| {} | {} | {}{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} |",
+            "| {} | {} | {}{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} |",
             c.label,
             c.nodes,
             wait_name(p.wait),
@@ -176,6 +184,7 @@ fn procs(w: &mut String, res: &Results, notes: &mut Vec<String>) {
             f(a.run_seconds, 2),
             f(a.lockstep, 2),
             f(a.wall.zip(a.lockstep).map(|(w, l)| w - l), 2),
+            f(per_node_ms(a.run_seconds, a.lockstep, c.nodes), 1),
             f(lock_rate, 0),
             f(ring_rate, 0),
             f(ratio(lock_rate), 2),
