@@ -1,5 +1,5 @@
 //! The first difference between a recorded run and its re-run: `states.bin`
-//! sample by sample (read with [`crate::results::states::read`]), values
+//! sample by sample (streamed, a record at a time: [`crate::results::states::open`]), values
 //! compared bit for bit (`f64::to_bits`: `-0.0 ≠ 0.0`, a NaN equals the
 //! same NaN), and `errors.csv` row by row.
 //!
@@ -11,8 +11,10 @@
 use super::VerifyError;
 use crate::results::fmt_time;
 use crate::results::layout::node_name;
-use crate::results::states::{self, AgentRecord, Header, LeaderRecord, Record};
+use crate::results::states::{self, AgentRecord, Header, LeaderRecord, Records};
 use std::fmt;
+use std::fs::File;
+use std::io::{self, BufReader, Read};
 use std::path::Path;
 
 /// The first difference of two `states.bin`.
@@ -64,7 +66,7 @@ pub enum StatesDifference {
     /// of the file outside any value).
     Bytes {
         /// The first differing byte.
-        offset: usize,
+        offset: u64,
     },
 }
 
@@ -114,30 +116,83 @@ impl fmt::Display for StatesDifference {
 }
 
 /// The first difference between the recorded `states.bin` and the re-run's.
+/// Both files are streamed: memory does not grow with the run's length.
 ///
 /// # Errors
 /// The re-run's own file cannot be read ([`VerifyError::Read`]).
 pub fn states(recorded: &Path, rerun: &Path) -> Result<Option<StatesDifference>, VerifyError> {
-    let bytes = |p: &Path| std::fs::read(p).map_err(|e| format!("{}: {e}", p.display()));
-    let ours = bytes(rerun).map_err(VerifyError::Read)?;
-    let theirs = match bytes(recorded) {
-        Ok(theirs) if theirs == ours => return Ok(None),
-        Ok(theirs) => theirs,
-        Err(why) => return Ok(Some(StatesDifference::Unreadable(why))),
+    let ours = File::open(rerun).map_err(|e| VerifyError::Read(read_error(rerun, &e)))?;
+    let theirs = match File::open(recorded) {
+        Ok(f) => f,
+        Err(e) => return Ok(Some(StatesDifference::Unreadable(read_error(recorded, &e)))),
     };
-    let (h1, r1) = match states::read(recorded) {
+    let offset = match first_difference(theirs, ours) {
+        Ok(None) => return Ok(None),
+        Ok(Some(offset)) => offset,
+        Err((Side::Recorded, e)) => {
+            return Ok(Some(StatesDifference::Unreadable(read_error(recorded, &e))));
+        }
+        Err((Side::Rerun, e)) => return Err(VerifyError::Read(read_error(rerun, &e))),
+    };
+    let mut a = match states::open(recorded) {
         Ok(x) => x,
         Err(why) => return Ok(Some(StatesDifference::Unreadable(why))),
     };
-    let (h2, r2) = states::read(rerun).map_err(VerifyError::Read)?;
-    let found = header(&h1, &h2)
-        .or_else(|| records(&h1, &r1, &r2))
-        .or_else(|| {
-            let offset = theirs.iter().zip(&ours).position(|(a, b)| a != b);
-            let offset = offset.unwrap_or(theirs.len().min(ours.len()));
-            Some(StatesDifference::Bytes { offset })
-        });
-    Ok(found)
+    let mut b = states::open(rerun).map_err(VerifyError::Read)?;
+    if let Some(d) = header(&a.header, &b.header) {
+        return Ok(Some(d));
+    }
+    Ok(Some(
+        records(&mut a, &mut b)?.unwrap_or(StatesDifference::Bytes { offset }),
+    ))
+}
+
+/// `FILE: error`.
+fn read_error(file: &Path, e: &io::Error) -> String {
+    format!("{}: {e}", file.display())
+}
+
+/// Which file a read error came from.
+#[derive(Debug, Clone, Copy)]
+enum Side {
+    Recorded,
+    Rerun,
+}
+
+/// The offset of the first byte where `a` and `b` differ (the shorter one's
+/// length if one is a prefix of the other), `None` if they are equal.
+fn first_difference(a: impl Read, b: impl Read) -> Result<Option<u64>, (Side, io::Error)> {
+    let (mut a, mut b) = (BufReader::new(a), BufReader::new(b));
+    let (mut x, mut y) = (vec![0; 1 << 16], vec![0; 1 << 16]);
+    let mut at = 0u64;
+    loop {
+        let n = fill(&mut a, &mut x).map_err(|e| (Side::Recorded, e))?;
+        let m = fill(&mut b, &mut y).map_err(|e| (Side::Rerun, e))?;
+        if let Some(k) = x[..n.min(m)].iter().zip(&y[..m]).position(|(p, q)| p != q) {
+            return Ok(Some(at + k as u64));
+        }
+        if n != m {
+            return Ok(Some(at + n.min(m) as u64));
+        }
+        if n == 0 {
+            return Ok(None);
+        }
+        at += n as u64;
+    }
+}
+
+/// Reads into `buf` until it is full or the stream ends; the bytes read.
+fn fill(r: &mut impl Read, buf: &mut [u8]) -> io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match r.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(n)
 }
 
 /// The first header field that differs.
@@ -169,16 +224,24 @@ fn header(a: &Header, b: &Header) -> Option<StatesDifference> {
     })
 }
 
-/// The first record that differs (`h`: the common header).
-fn records(h: &Header, a: &[Record], b: &[Record]) -> Option<StatesDifference> {
-    for (index, (x, y)) in a.iter().zip(b).enumerate() {
+/// The first record that differs (the headers are equal), read a record at
+/// a time; a recorded record that cannot be read is itself the difference.
+fn records(a: &mut Records, b: &mut Records) -> Result<Option<StatesDifference>, VerifyError> {
+    let (ra, rb) = (a.remaining(), b.remaining());
+    let h = a.header.clone();
+    for (index, (x, y)) in a.by_ref().zip(b.by_ref()).enumerate() {
+        let x = match x {
+            Ok(x) => x,
+            Err(why) => return Ok(Some(StatesDifference::Unreadable(why))),
+        };
+        let y = y.map_err(VerifyError::Read)?;
         if x.step != y.step {
             let (recorded, rerun) = (x.step, y.step);
-            return Some(StatesDifference::Step {
+            return Ok(Some(StatesDifference::Step {
                 index,
                 recorded,
                 rerun,
-            });
+            }));
         }
         let at = |node: String, (field, recorded, rerun): Diff| StatesDifference::Sample {
             t: fmt_time(x.step, h.dt),
@@ -189,19 +252,19 @@ fn records(h: &Header, a: &[Record], b: &[Record]) -> Option<StatesDifference> {
             rerun,
         };
         if let Some(d) = leader(&x.leader, &y.leader) {
-            return Some(at(node_name(0), d));
+            return Ok(Some(at(node_name(0), d)));
         }
         let agents = h.agent_ids.iter().zip(x.agents.iter().zip(&y.agents));
         for (&id, (p, q)) in agents {
             if let Some(d) = agent(p, q) {
-                return Some(at(node_name(id), d));
+                return Ok(Some(at(node_name(id), d)));
             }
         }
     }
-    (a.len() != b.len()).then_some(StatesDifference::Samples {
-        recorded: a.len(),
-        rerun: b.len(),
-    })
+    Ok((ra != rb).then_some(StatesDifference::Samples {
+        recorded: ra as usize,
+        rerun: rb as usize,
+    }))
 }
 
 /// A differing value: (field name, recorded, re-run).
@@ -324,6 +387,21 @@ pub fn errors_csv(recorded: &Path, rerun: &Path) -> Result<Option<RowDifference>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_first_differing_byte_is_found_across_buffer_boundaries() {
+        let a: Vec<u8> = (0..200_000u32).map(|i| (i % 251) as u8).collect();
+        let at = |x: &[u8], y: &[u8]| first_difference(x, y).unwrap();
+        assert_eq!(at(&a, &a), None);
+        for k in [0, 1, 65_535, 65_536, 65_537, 199_999] {
+            let mut b = a.clone();
+            b[k] ^= 1;
+            assert_eq!(at(&a, &b), Some(k as u64), "byte {k}");
+        }
+        assert_eq!(at(&a, &a[..70_000]), Some(70_000), "a prefix");
+        assert_eq!(at(&a[..1], &a), Some(1));
+        assert_eq!(at(&[], &[]), None);
+    }
 
     #[test]
     fn fields_are_named_by_row_and_column() {

@@ -30,9 +30,6 @@ use crate::results::layout::RunLayout;
 use crate::results::{Summary, states};
 use attitude::engine::Snapshot;
 use attitude::network::{AgentState, Network};
-use attitude::reference::LeaderState;
-use msgs::from_rows;
-use nalgebra::Vector3;
 use std::io;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -178,9 +175,11 @@ fn network_of(file: &Path) -> Result<Network, ViewError> {
     }
 }
 
-/// The frames of `states.bin` of a run of `net`, as the run collected them.
+/// The frames of `states.bin` of a run of `net`, as the run collected them
+/// (read a record at a time: memory does not grow with the run's length).
 fn replay(file: &Path, net: &Network) -> Result<Frames, ViewError> {
-    let (header, records) = states::read(file).map_err(ViewError::States)?;
+    let records = states::open(file).map_err(ViewError::States)?;
+    let header = &records.header;
     let ids: Vec<u32> = net.agents.iter().map(|a| a.model.id).collect();
     if header.agent_ids != ids || header.sample_every != net.sample_every {
         return Err(ViewError::Mismatch {
@@ -192,24 +191,14 @@ fn replay(file: &Path, net: &Network) -> Result<Frames, ViewError> {
         });
     }
     let mut collector = Collector::new(net);
-    for rec in &records {
-        let leader = LeaderState {
-            r0: from_rows(&rec.leader.r0),
-            w0: Vector3::from(rec.leader.w0),
-            s0: Vector3::from(rec.leader.s0),
-        };
-        let agents: Vec<AgentState> = (rec.agents.iter())
-            .map(|a| AgentState {
-                r: from_rows(&a.r),
-                w: Vector3::from(a.w),
-                r_hat: from_rows(&a.r_hat),
-                w_hat: Vector3::from(a.w_hat),
-                s_hat: Vector3::from(a.s_hat),
-            })
-            .collect();
+    let mut agents: Vec<AgentState> = Vec::with_capacity(ids.len());
+    for rec in records {
+        let rec = rec.map_err(ViewError::States)?;
+        agents.clear();
+        agents.extend(rec.agents.iter().map(states::AgentRecord::state));
         collector.push(&Snapshot {
             step: rec.step,
-            leader: &leader,
+            leader: &rec.leader.state(),
             agents: &agents,
         });
     }
