@@ -106,6 +106,7 @@ impl Error {
             self,
             Error::Scenario(_)
                 | Error::Hosts(_)
+                | Error::Run(RunError::Hosts(_))
                 | Error::Sweep(SweepError::Scenario(_))
                 | Error::Mc(crate::mc::McError::Scenario(_))
         )
@@ -117,7 +118,7 @@ pub const DIVERGED: u8 = 3;
 
 fn run_code(e: &RunError) -> u8 {
     match e {
-        RunError::Options(_) | RunError::Capacity(_) => 2,
+        RunError::Options(_) | RunError::Capacity(_) | RunError::Hosts(_) => 2,
         _ => 1,
     }
 }

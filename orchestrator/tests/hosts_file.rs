@@ -9,6 +9,7 @@ mod common;
 
 use common::PAPER;
 use std::collections::{BTreeMap, BTreeSet};
+use std::ffi::OsStr;
 use std::fs;
 use std::path::{Path, PathBuf};
 
@@ -371,4 +372,76 @@ fn unreadable_oversized_and_non_utf8_files_are_refused() {
             latin1.display()
         )
     );
+}
+
+/// `attsync ARGS…` in `dir`: each argument a string or a path.
+fn attsync_in(dir: &Path, args: &[&dyn AsRef<OsStr>]) -> common::Out {
+    let args: Vec<&OsStr> = args.iter().map(|a| a.as_ref()).collect();
+    common::attsync(dir, &args)
+}
+
+#[test]
+fn run_and_sweep_refuse_a_bad_or_misfitting_hosts_file_before_anything_starts() {
+    let (dir, bad) = write("bad.toml", &host("a", EP, "agents = [1, 1]"));
+    let unknown = dir.path().join("unknown.toml");
+    fs::write(&unknown, host("a", EP, "agents = [9]")).unwrap();
+    let out = dir.path().join("out");
+    let run = |hosts: &Path| {
+        let args: [&dyn AsRef<OsStr>; 7] = [
+            &"run", &PAPER, &"--quiet", &"--out", &out, &"--hosts", &hosts,
+        ];
+        attsync_in(dir.path(), &args)
+    };
+    let sweep = |hosts: &Path| {
+        let param = ["--param", "network.delay", "--values", "0,0.01"];
+        let args: [&dyn AsRef<OsStr>; 10] = [
+            &"sweep", &PAPER, &param[0], &param[1], &param[2], &param[3], &"--out", &out,
+            &"--hosts", &hosts,
+        ];
+        attsync_in(dir.path(), &args)
+    };
+    let twice = format!(
+        "{}: host[0].agents[1]: agent 1 is already placed at host[0].agents[0]",
+        bad.display()
+    );
+    let missing = format!(
+        "{}: host[0].agents[0]: agent 9 does not exist (the scenario has 7 agents)",
+        unknown.display()
+    );
+    for (what, o, expected) in [
+        ("run", run(&bad), &twice),
+        ("sweep", sweep(&bad), &twice),
+        ("run", run(&unknown), &missing),
+        ("sweep", sweep(&unknown), &missing),
+    ] {
+        o.assert_code(2);
+        assert!(
+            o.stderr.starts_with(expected.as_str()),
+            "{what}: {}",
+            o.stderr
+        );
+        assert!(!out.exists(), "{what} wrote {}", out.display());
+    }
+}
+
+#[test]
+fn hosts_need_the_process_engine_and_conform_says_it_runs_on_this_machine_only() {
+    let (dir, hosts) = write("hosts.toml", SPLIT);
+    let args: [&dyn AsRef<OsStr>; 6] = [
+        &"run",
+        &PAPER,
+        &"--engine",
+        &"in-process",
+        &"--hosts",
+        &hosts,
+    ];
+    let out = attsync_in(dir.path(), &args);
+    out.assert_code(2);
+    let expected = "error: --hosts needs --engine processes";
+    assert!(out.stderr.starts_with(expected), "{}", out.stderr);
+    let args: [&dyn AsRef<OsStr>; 5] = [&"conform", &"--hosts", &hosts, &"--", &"true"];
+    let out = attsync_in(dir.path(), &args);
+    out.assert_code(2);
+    let expected = "error: --hosts: conform runs one candidate on this machine only";
+    assert!(out.stderr.starts_with(expected), "{}", out.stderr);
 }
