@@ -1,6 +1,7 @@
 //! `attsync run`: a loaded scenario through an engine into a results
 //! directory.
 
+use crate::hosts::{Hosts, HostsError, Placement};
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
 use crate::outcome::Outcome;
@@ -55,6 +56,9 @@ pub struct RunOptions {
     /// Write `view.html` (`attsync run`, unless `--no-view`; not in a
     /// sweep's runs: one page per value would be most of the sweep's size).
     pub view: bool,
+    /// `--hosts`: the machines the nodes are spread over (`None`: all on
+    /// this one). Placed on the scenario before anything starts.
+    pub hosts: Option<Hosts>,
 }
 
 /// The default `--threads`: the number of cores (1 if unknown).
@@ -75,6 +79,12 @@ impl RunOptions {
         options::threads(self.threads)?;
         if let Some(f) = self.processes.realtime {
             options::realtime(f)?;
+        }
+        if self.hosts.is_some() && self.engine == Engine::InProcess {
+            return Err(OptionError::Conflict(
+                "--hosts needs --engine processes (the in-process engine runs every node in this process)"
+                    .into(),
+            ));
         }
         Ok(())
     }
@@ -109,6 +119,14 @@ pub enum RunError {
     /// Writing `view.html` failed.
     #[error(transparent)]
     View(#[from] crate::view::ViewError),
+    /// The hosts file does not fit the scenario (nothing started).
+    #[error(transparent)]
+    Hosts(#[from] HostsError),
+    /// A run across machines was asked for; this build cannot carry one
+    /// yet (a temporary state of the `hostsfile` branch: the host daemons
+    /// and the bridge replace it).
+    #[error("multi-host runs need the host daemons (not built in this commit)")]
+    NoHostDaemons,
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -139,6 +157,11 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let started_at = SystemTime::now();
     opts.validate()?;
     check_options(loaded, opts)?;
+    if let Some(hosts) = &opts.hosts {
+        let placement = Placement::of(hosts, &loaded.resolved.network)?;
+        tracing::debug!(cut_edges = placement.cut_edges().len(), "run: placed");
+        return Err(RunError::NoHostDaemons);
+    }
     check_capacity(loaded, opts)?;
     let staging = Staging::claim(&opts.out).map_err(|e| match e {
         // A foreign or busy --out: refused before anything started (exit 2).
@@ -473,6 +496,7 @@ mod tests {
             progress: false,
             threads: 1,
             view: false,
+            hosts: None,
         }
     }
 
