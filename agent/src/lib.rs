@@ -5,10 +5,12 @@
 //! # Layout
 //! - [`runtime`]: the lockstep node loop shared with the leader process.
 //! - [`wait`]: waiting strategies.
+//! - [`backpressure`]: how a publisher paces itself while a receiver is full.
 //! - [`args`]: the command line shared by the agent and leader binaries.
 //! - [`AgentNode`]: the model ([`attitude::agent::Agent`]) behind the loop.
 
 pub mod args;
+pub mod backpressure;
 pub mod runtime;
 pub mod wait;
 
