@@ -5,10 +5,12 @@
 //! # Layout
 //! - [`runtime`]: the lockstep node loop shared with the leader process.
 //! - [`wait`]: waiting strategies.
+//! - [`backpressure`]: how a publisher paces itself while a receiver is full.
 //! - [`args`]: the command line shared by the agent and leader binaries.
 //! - [`AgentNode`]: the model ([`attitude::agent::Agent`]) behind the loop.
 
 pub mod args;
+pub mod backpressure;
 pub mod runtime;
 pub mod wait;
 
@@ -48,11 +50,14 @@ impl Stepper for AgentNode {
         self.agent.stage_exchange()
     }
 
+    /// `x` was validated by the runtime ([`msgs::StateMsg::validated`],
+    /// the same [`Exchanged::trust`] the agent would apply), so the agent
+    /// takes it as judged trusted instead of checking it a second time.
     fn receive(&mut self, k: usize, x: Exchanged) {
         if k < self.agent.model().neighbours.len() {
-            self.agent.receive_neighbour(k, x);
+            self.agent.receive_neighbour_judged(k, x, true);
         } else {
-            self.agent.receive_leader(x);
+            self.agent.receive_leader_judged(x, true);
         }
     }
 

@@ -199,17 +199,6 @@ fn block<S: Service>(listener: &Listener<S>, slice: Duration) {
     let _ = listener.timed_wait(|_| {}, slice);
 }
 
-/// What a publisher does while a receiver's buffer is full: sleep briefly
-/// rather than yield, so that a sender far ahead (the leader, which has no
-/// inputs) leaves the core to the nodes it waits for — a yield would hand it
-/// to any competitor for a whole time slice and keep the sender runnable.
-pub fn backpressure_pause() {
-    std::thread::sleep(BACKPRESSURE_SLEEP);
-}
-
-/// The pause of [`backpressure_pause`].
-pub const BACKPRESSURE_SLEEP: Duration = Duration::from_micros(50);
-
 #[cfg(test)]
 mod tests {
     use super::*;

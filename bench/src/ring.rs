@@ -9,7 +9,7 @@
 //! ([`msgs::open::state`], [`msgs::open::wake`]) with a [`Limits`] built here
 //! (nodes N, max_fanout 2, state_buffer 64, telemetry_buffer 256), the same
 //! 144-byte [`StateMsg`], the same publisher backpressure (`RetryUntilDelivered`,
-//! yield and retry until the stage timeout) and the same
+//! the runtime's [`attsync_agent::backpressure`] pause and retry until the stage timeout) and the same
 //! [`attsync_agent::wait::Waiter`]. Per step: 4 exchanges; per exchange:
 //! publish, notify the receivers (if the strategy lets them block), then take
 //! each input's message, one at a time, and check its (step, stage) stamp.
@@ -29,6 +29,7 @@
 //! (times in seconds; `elapsed` covers the lockstep loop only).
 
 use crate::error::{BenchError, Result};
+use attsync_agent::backpressure::{Pacer, retry_until};
 use attsync_agent::wait::Waiter;
 use iceoryx2::node::Node;
 use iceoryx2::port::listener::Listener;
@@ -36,7 +37,6 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::port::update_connections::UpdateConnections;
-use iceoryx2::port::{BackpressureAction, BackpressureInfo};
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSub;
 use msgs::config::{Contention, WaitStrategy};
@@ -176,25 +176,13 @@ fn touch(path: &Path) -> Result<()> {
     std::fs::write(path, b"").map_err(BenchError::io(path))
 }
 
-/// The runtime's backpressure handler: pause and retry until `timeout`, then fail the send.
-fn retry_until(
-    timeout: Duration,
-) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send + 'static {
-    move |info| {
-        if info.elapsed_time > timeout {
-            BackpressureAction::DiscardDataAndFail
-        } else {
-            attsync_agent::wait::backpressure_pause();
-            BackpressureAction::Retry
-        }
-    }
-}
-
 /// A ring node's ports, opened exactly as the node runtime opens them.
 struct Ports {
     /// Our state service (its subscriber count is the readiness condition).
     own: PubSub<ipc::Service, StateMsg, ()>,
     publisher: Publisher<ipc::Service, StateMsg, ()>,
+    /// Paces `publisher` while a receiver's buffer is full.
+    pacer: Pacer,
     listener: Listener<ipc::Service>,
     /// One per input, in input order.
     subs: Vec<Subscriber<ipc::Service, StateMsg, ()>>,
@@ -214,10 +202,11 @@ impl Ports {
     ) -> Result<Self> {
         let (inputs, outputs) = io;
         let own = msgs::open::state(node, run, id, limits).map_err(BenchError::iox_msg("state"))?;
+        let pacer = Pacer::new(limits.state_buffer);
         let publisher = own
             .publisher_builder()
             .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
-            .set_backpressure_handler(retry_until(stage_timeout))
+            .set_backpressure_handler(retry_until(stage_timeout, pacer.clone()))
             .create()
             .map_err(BenchError::iox("state publisher"))?;
         let listener = msgs::open::wake(node, run, id, limits)
@@ -251,6 +240,7 @@ impl Ports {
         Ok(Self {
             own,
             publisher,
+            pacer,
             listener,
             subs,
             input_services,
@@ -391,6 +381,7 @@ impl RingNode {
                 p.publisher
                     .send_copy(state(id, n, s))
                     .map_err(BenchError::iox("state send"))?;
+                p.pacer.sent();
                 if notify {
                     for nt in &p.notifiers {
                         let _ = nt.notify();

@@ -1,6 +1,7 @@
 //! Every iceoryx2 port a node uses, and the readiness barrier.
 
 use super::{NodeError, Orphan, port};
+use crate::backpressure::{Pacer, retry_until};
 use iceoryx2::node::Node;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::notifier::Notifier;
@@ -19,10 +20,13 @@ pub(crate) struct Ports<S: Service> {
     own: PubSub<S, StateMsg, ()>,
     /// Publishes our state.
     pub publisher: Publisher<S, StateMsg, ()>,
+    /// Paces `publisher` while a receiver's buffer is full (lockstep).
+    pacer: Pacer,
     /// Our wake event (inputs have news).
     pub listener: Listener<S>,
     tele: PubSub<S, TelemetryMsg, ()>,
     tele_pub: Publisher<S, TelemetryMsg, ()>,
+    tele_pacer: Pacer,
     orch_notifier: Notifier<S>,
     /// Orchestrator commands.
     pub control: Subscriber<S, ControlMsg, ()>,
@@ -41,11 +45,12 @@ impl<S: Service> Ports<S> {
         let (run, l, id) = (cfg.run.as_str(), &cfg.limits, cfg.id);
         let stage_timeout = Duration::from_secs_f64(cfg.stage_timeout);
         let own = open::state(node, run, id, l)?;
+        let pacer = Pacer::new(l.state_buffer);
         let publisher = match cfg.realtime {
             None => own
                 .publisher_builder()
                 .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
-                .set_backpressure_handler(retry_until(stage_timeout)),
+                .set_backpressure_handler(retry_until(stage_timeout, pacer.clone())),
             Some(_) => own
                 .publisher_builder()
                 .backpressure_strategy(BackpressureStrategy::DiscardData),
@@ -57,10 +62,11 @@ impl<S: Service> Ports<S> {
             .create()
             .map_err(port("wake listener"))?;
         let tele = open::telemetry(node, run, id, l)?;
+        let tele_pacer = Pacer::new(l.telemetry_buffer);
         let tele_pub = tele
             .publisher_builder()
             .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
-            .set_backpressure_handler(retry_until(stage_timeout))
+            .set_backpressure_handler(retry_until(stage_timeout, tele_pacer.clone()))
             .create()
             .map_err(port("telemetry publisher"))?;
         let orch_notifier = open::orchestrator_wake(node, run, l)?
@@ -96,9 +102,11 @@ impl<S: Service> Ports<S> {
         Ok(Self {
             own,
             publisher,
+            pacer,
             listener,
             tele,
             tele_pub,
+            tele_pacer,
             orch_notifier,
             control,
             inputs,
@@ -164,6 +172,7 @@ impl<S: Service> Ports<S> {
         self.tele_pub
             .send_copy(TelemetryMsg::encode(id, t))
             .map_err(port("telemetry send"))?;
+        self.tele_pacer.sent();
         if !matches!(t, Telemetry::Sample { .. } | Telemetry::LeaderSample { .. }) {
             let _ = self.orch_notifier.notify();
         }
@@ -173,6 +182,7 @@ impl<S: Service> Ports<S> {
     /// Publishes our state and, if `notify`, wakes every receiver.
     pub fn publish(&self, m: StateMsg, notify: bool) -> Result<(), NodeError> {
         self.publisher.send_copy(m).map_err(port("state send"))?;
+        self.pacer.sent();
         if notify {
             for nt in &self.notifiers {
                 let _ = nt.notify();
@@ -205,21 +215,5 @@ impl Backoff {
     pub(crate) fn sleep(&mut self) {
         std::thread::sleep(self.0);
         self.0 = (self.0 * 2).min(Self::MAX);
-    }
-}
-
-/// A backpressure handler: pause ([`crate::wait::backpressure_pause`]) and retry until `timeout`, then give up on
-/// that receiver and fail the send (so nothing hangs).
-fn retry_until(
-    timeout: Duration,
-) -> impl Fn(&iceoryx2::port::BackpressureInfo) -> iceoryx2::port::BackpressureAction + Send + 'static
-{
-    move |info| {
-        if info.elapsed_time > timeout {
-            iceoryx2::port::BackpressureAction::DiscardDataAndFail
-        } else {
-            crate::wait::backpressure_pause();
-            iceoryx2::port::BackpressureAction::Retry
-        }
     }
 }
