@@ -127,6 +127,16 @@ impl Judged {
         let trusted = x.trust().is_ok();
         Self(x, trusted)
     }
+
+    /// What every receiver of a sender holds once it publishes `x` with
+    /// the verdict `trusted`, `before` being what they held: `x` if
+    /// trusted, else `before` (a receiver refuses an untrusted value and
+    /// keeps what it had, [`crate::agent::Agent::receive_neighbour`]). The
+    /// same for every receiver of the sender, so kept once, on the board.
+    #[must_use]
+    pub fn held(x: Exchanged, trusted: bool, before: &Exchanged) -> Self {
+        Self(if trusted { x } else { *before }, trusted)
+    }
 }
 
 /// Words of a [`Judged`]: the value, then 1 (trusted) or 0.
