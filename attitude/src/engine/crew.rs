@@ -19,7 +19,7 @@
 
 use super::PerAgent;
 use super::barrier::SpinBarrier;
-use super::board::{AGENT_STATE, EXCHANGED, JUDGED, Judged, Slot as Shared, slots};
+use super::board::{AGENT_STATE, EXCHANGED, JUDGED, Judged, Lined, Slot as Shared, slots};
 use super::pass::{Stage, pass};
 use crate::agent::Agent;
 use crate::guard::{Envelope, Violation};
@@ -36,7 +36,7 @@ pub(super) struct Board {
     /// ([`Judged::held`]), two buffers used in turn (exchange k of the run
     /// reads buffer k mod 2; between exchanges the last one's is read):
     /// agents in network order, then the leader.
-    published: [Vec<Shared<JUDGED>>; 2],
+    published: [Vec<Lined<Shared<JUDGED>>>; 2],
     /// Every agent's state at the end of the last sampled step.
     states: Vec<Shared<AGENT_STATE>>,
     /// Every agent's peak torque at the end of the last sampled step.
@@ -57,7 +57,8 @@ impl Board {
         let agents = published[0].len();
         Self {
             published: published.each_ref().map(|values| {
-                let buffer = slots(agents + 1);
+                let buffer: Vec<Lined<Shared<JUDGED>>> =
+                    (0..=agents).map(|_| Lined::default()).collect();
                 for (slot, x) in buffer.iter().zip(values) {
                     slot.store(x);
                 }
