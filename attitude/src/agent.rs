@@ -125,7 +125,10 @@ fn from_lie(y: &LieState<2, 3>) -> AgentState {
 }
 
 /// A follower stepping its closed loop with RKMK4, stage by stage.
+/// Aligned to a cache line (64 B): an engine sweeps many agents at every
+/// stage, and an agent then touches only its own lines.
 #[derive(Debug, Clone)]
+#[repr(align(64))]
 pub struct Agent {
     model: AgentModel,
     gains: Vec<Matrix3<f64>>,
@@ -144,6 +147,9 @@ pub struct Agent {
     /// that an agent without any (the common case) steps over a few
     /// pointers, not over whole links, at every stage.
     links: Vec<Option<Box<Link>>>,
+    /// Whether any input is impaired (else `links` is not looked at while
+    /// stepping: one allocation fewer touched per stage).
+    impaired: bool,
     /// Values refused as untrusted, per input (neighbours, then the leader).
     rejected: Vec<u64>,
     /// Current step index.
@@ -170,6 +176,7 @@ impl Agent {
             links.push(impaired(&model.leader_link));
         }
         let rejected = vec![0; links.len()];
+        let impaired = links.iter().any(Option::is_some);
         Self {
             model,
             gains,
@@ -181,6 +188,7 @@ impl Agent {
             held_nbrs,
             held_leader,
             links,
+            impaired,
             n: 0,
             peak_torque: 0.0,
             verdicts: Verdicts::default(),
@@ -262,10 +270,28 @@ impl Agent {
         self.hold_neighbour(k, &x, trusted);
     }
 
+    /// What an engine that keeps the neighbours' values itself (the
+    /// in-process engine's board) tells the agent of the `k`-th
+    /// neighbour's value at an exchange: a refusal is counted, an impaired
+    /// link gets the value; an unimpaired input's value is not copied
+    /// (it is handed to [`Self::advance_with`] from where it lies).
+    #[inline]
+    pub(crate) fn hear_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool) {
+        if !trusted {
+            self.rejected[k] += 1;
+            return;
+        }
+        if !self.impaired {
+            return;
+        }
+        if let Some(link) = &mut self.links[k] {
+            link.offer(self.n, self.step.stage() as u32, *x);
+        }
+    }
+
     /// [`Self::receive_neighbour_judged`] from where the value lies (one
     /// copy, into the held value).
-    #[inline]
-    pub(crate) fn hold_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool) {
+    fn hold_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool) {
         if !trusted {
             self.rejected[k] += 1;
             return;
@@ -321,12 +347,51 @@ impl Agent {
     /// Evaluates the current stage with the held inputs and moves on.
     /// Returns `true` when a step completed.
     pub fn advance(&mut self) -> bool {
-        let stage = self.step.stage();
+        self.update_links();
+        let (d, tau) = agent_field(
+            &self.model,
+            &self.gains,
+            &self.stage_x,
+            &self.held_nbrs,
+            self.held_leader.as_deref(),
+        );
+        self.finish_stage(&d, &tau)
+    }
+
+    /// [`Self::advance`] for an agent told of its inputs by
+    /// [`Self::hear_neighbour`]: `nbrs[k]` is what the `k`-th neighbour's
+    /// unimpaired input holds (the engine keeps it: the sender's last
+    /// trusted value, identical for every receiver); an impaired input's
+    /// entry is replaced by its link's held value. The same arithmetic on
+    /// the same values as [`Self::advance`], bit for bit.
+    pub(crate) fn advance_with(&mut self, nbrs: &mut [Exchanged]) -> bool {
+        if self.impaired {
+            self.update_links();
+            for ((x, link), held) in nbrs.iter_mut().zip(&self.links).zip(&self.held_nbrs) {
+                if link.is_some() {
+                    *x = *held;
+                }
+            }
+        }
+        let (d, tau) = agent_field(
+            &self.model,
+            &self.gains,
+            &self.stage_x,
+            nbrs,
+            self.held_leader.as_deref(),
+        );
+        self.finish_stage(&d, &tau)
+    }
+
+    /// The held value of every impaired input whose link delivers one at
+    /// this stage ([`Link::value_at`]).
+    fn update_links(&mut self) {
+        let stage = self.step.stage() as u32;
         let n_nbrs = self.held_nbrs.len();
         for (k, link) in self.links.iter_mut().enumerate() {
             if let Some(x) = link
                 .as_mut()
-                .and_then(|l| l.value_at(self.n, stage as u32, self.dt))
+                .and_then(|l| l.value_at(self.n, stage, self.dt))
             {
                 if k < n_nbrs {
                     self.held_nbrs[k] = x;
@@ -335,17 +400,15 @@ impl Agent {
                 }
             }
         }
-        let (d, tau) = agent_field(
-            &self.model,
-            &self.gains,
-            &self.stage_x,
-            &self.held_nbrs,
-            self.held_leader.as_deref(),
-        );
-        if stage == 0 {
+    }
+
+    /// Hands the stage's derivative `d` (and torque `tau`) to RKMK4 and
+    /// moves to the next stage state; `true` when a step completed.
+    fn finish_stage(&mut self, d: &AgentDerivative, tau: &Vector3<f64>) -> bool {
+        if self.step.stage() == 0 {
             self.peak_torque = self.peak_torque.max(tau.norm());
         }
-        match self.step.push_derivative(start(&self.state), &d) {
+        match self.step.push_derivative(start(&self.state), d) {
             Some(next) => {
                 self.state = from_lie(&next);
                 self.step.restart(&next.vec);

@@ -24,7 +24,7 @@ mod pass;
 
 use crate::agent::Agent;
 use crate::guard::{self, Divergence, Violation};
-use crate::network::{AgentState, Network};
+use crate::network::{AgentState, Exchanged, Network};
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::{Schedule, Slot};
 use board::Judged;
@@ -62,12 +62,16 @@ pub struct InProcess {
     sampled: (u64, Vec<f64>),
     /// Threads [`Self::run`] uses (1: the calling thread only).
     threads: usize,
-    /// The one-thread step's published values and their verdicts
-    /// ([`crate::network::Exchanged::trust`], judged once per sender): the
-    /// next exchange reads `published[0]`; a pass at an exchange writes the
-    /// values of the exchange after it into `published[1]`, then the two
-    /// swap.
+    /// The published values as their receivers hold them ([`Judged::held`])
+    /// and their verdicts ([`crate::network::Exchanged::trust`], judged once
+    /// per sender): the next exchange reads `published[0]`, `published[1]`
+    /// holds the last exchange's (read between exchanges); a pass at an
+    /// exchange writes the values of the exchange after it into
+    /// `published[1]`, then the two swap. The crew starts from them and
+    /// leaves them as it found them.
     published: [Vec<Judged>; 2],
+    /// Every agent's neighbour values, one agent at a time (see `pass`).
+    scratch: Vec<Exchanged>,
     /// The exchange (step, stage) whose values the last pass published.
     ready: Option<(u64, u32)>,
 }
@@ -95,6 +99,7 @@ impl InProcess {
             sampled: (0, Vec::new()),
             threads: 1,
             published: [vec![Judged::default(); n], vec![Judged::default(); n]],
+            scratch: Vec::new(),
             ready: None,
         }
     }
@@ -179,11 +184,14 @@ impl InProcess {
             found = pass(
                 &mut self.agents,
                 &self.nbr_index,
-                stage,
+                (stage, &mut self.scratch),
                 |j| &read[j],
                 |k, a| {
                     let Judged(x, trusted) = &mut out[k];
                     *trusted = a.publish_into(x);
+                    if !*trusted {
+                        *x = read[k].0;
+                    }
                 },
             );
             if slot.exchange {
@@ -201,9 +209,10 @@ impl InProcess {
     /// exchange `slot`, unless the last pass did.
     fn publish_if_needed(&mut self, slot: Slot) {
         if self.ready != Some((slot.step, slot.stage)) {
-            for (p, a) in self.published[0].iter_mut().zip(&mut self.agents) {
+            let [now, last] = &mut self.published;
+            for ((p, before), a) in now.iter_mut().zip(&*last).zip(&mut self.agents) {
                 let (x, trusted) = a.stage_exchange_judged();
-                *p = Judged(x, trusted);
+                *p = Judged::held(x, trusted, &before.0);
             }
         }
     }
@@ -312,9 +321,10 @@ impl InProcess {
             states,
             threads,
             sampled,
+            published,
             ..
         } = self;
-        let board = Board::new(agents.len(), *threads);
+        let board = Board::new(published, *threads);
         let plan = Plan {
             schedule: Schedule::new(net.coupling, net.steps),
             nbr_index,
@@ -322,13 +332,14 @@ impl InProcess {
             guard: &net.guard,
         };
         let (from, outs) = (*step, crew::outputs::<T>(*threads));
-        std::thread::scope(|scope| {
+        let (diverged, parity) = std::thread::scope(|scope| {
             let mut shares = Share::split(agents, *threads).into_iter();
             let mut mine = shares.next().expect("at least one share");
             for (share, out) in shares.zip(&outs[1..]) {
                 let board = &board;
                 scope.spawn(move || crew::work(share, board, plan, from, (work, out)));
             }
+            let ended = |mine: &Share<'_>, d| (d, mine.parity());
             while *step < net.steps {
                 mine.step(&board, plan, *step, Some(leader));
                 *step += 1;
@@ -341,7 +352,7 @@ impl InProcess {
                 let found = crew::read_found(&board);
                 if let Some(d) = divergence_at(net, *step, leader.state(), found) {
                     crew::release(&board, false);
-                    return Some(d);
+                    return ended(&mine, Some(d));
                 }
                 if !due {
                     crew::release(&board, true);
@@ -357,11 +368,13 @@ impl InProcess {
                 let go_on = on_sample(&snapshot, all.as_slice());
                 crew::release(&board, go_on);
                 if !go_on {
-                    return None;
+                    return ended(&mine, None);
                 }
             }
-            None
-        })
+            ended(&mine, None)
+        });
+        crew::read_published(&board, parity, published);
+        diverged
     }
 }
 

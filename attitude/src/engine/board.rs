@@ -45,6 +45,19 @@ impl<const N: usize> Slot<N> {
     }
 }
 
+/// A value aligned to a cache line (64 B), as [`Judged`] is: a shared
+/// published value is two lines, not three.
+#[derive(Debug, Default)]
+#[repr(align(64))]
+pub struct Lined<T>(pub T);
+
+impl<T> std::ops::Deref for Lined<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.0
+    }
+}
+
 /// `n` shared slots.
 #[must_use]
 pub fn slots<const N: usize>(n: usize) -> Vec<Slot<N>> {
@@ -109,8 +122,11 @@ impl Words<EXCHANGED> for LeaderState {
 }
 
 /// A published value and whether receivers may use it
-/// ([`Exchanged::trust`], judged once by the sender's thread).
+/// ([`Exchanged::trust`], judged once by the sender's thread). Aligned to
+/// a cache line (64 B on x86-64 and AArch64), so that one is two lines,
+/// not three: the engine reads each neighbour's at every stage.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[repr(align(64))]
 pub struct Judged(pub Exchanged, pub bool);
 
 impl Default for Judged {
@@ -126,6 +142,16 @@ impl Judged {
     pub fn of(x: Exchanged) -> Self {
         let trusted = x.trust().is_ok();
         Self(x, trusted)
+    }
+
+    /// What every receiver of a sender holds once it publishes `x` with
+    /// the verdict `trusted`, `before` being what they held: `x` if
+    /// trusted, else `before` (a receiver refuses an untrusted value and
+    /// keeps what it had, [`crate::agent::Agent::receive_neighbour`]). The
+    /// same for every receiver of the sender, so kept once, on the board.
+    #[must_use]
+    pub fn held(x: Exchanged, trusted: bool, before: &Exchanged) -> Self {
+        Self(if trusted { x } else { *before }, trusted)
     }
 }
 

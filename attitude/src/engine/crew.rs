@@ -19,11 +19,11 @@
 
 use super::PerAgent;
 use super::barrier::SpinBarrier;
-use super::board::{AGENT_STATE, EXCHANGED, JUDGED, Judged, Slot as Shared, slots};
+use super::board::{AGENT_STATE, EXCHANGED, JUDGED, Judged, Lined, Slot as Shared, slots};
 use super::pass::{Stage, pass};
 use crate::agent::Agent;
 use crate::guard::{Envelope, Violation};
-use crate::network::AgentState;
+use crate::network::{AgentState, Exchanged};
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::{Schedule, Slot};
 use std::sync::Mutex;
@@ -32,9 +32,11 @@ use std::sync::atomic::{AtomicBool, Ordering::SeqCst};
 /// What the threads share.
 #[derive(Debug)]
 pub(super) struct Board {
-    /// Published stage states, two buffers used in turn (exchange k reads
-    /// buffer k mod 2): agents in network order, then the leader.
-    published: [Vec<Shared<JUDGED>>; 2],
+    /// Published stage states as their receivers hold them
+    /// ([`Judged::held`]), two buffers used in turn (exchange k of the run
+    /// reads buffer k mod 2; between exchanges the last one's is read):
+    /// agents in network order, then the leader.
+    published: [Vec<Lined<Shared<JUDGED>>>; 2],
     /// Every agent's state at the end of the last sampled step.
     states: Vec<Shared<AGENT_STATE>>,
     /// Every agent's peak torque at the end of the last sampled step.
@@ -49,10 +51,19 @@ pub(super) struct Board {
 }
 
 impl Board {
-    /// A board for `agents` agents and `threads` threads.
-    pub(super) fn new(agents: usize, threads: usize) -> Self {
+    /// A board for `threads` threads whose agents' values are
+    /// `published` (the one-thread step's buffers, as it left them).
+    pub(super) fn new(published: &[Vec<Judged>; 2], threads: usize) -> Self {
+        let agents = published[0].len();
         Self {
-            published: [slots(agents + 1), slots(agents + 1)],
+            published: published.each_ref().map(|values| {
+                let buffer: Vec<Lined<Shared<JUDGED>>> =
+                    (0..=agents).map(|_| Lined::default()).collect();
+                for (slot, x) in buffer.iter().zip(values) {
+                    slot.store(x);
+                }
+                buffer
+            }),
             states: slots(agents),
             peaks: slots(agents),
             leader: Shared::default(),
@@ -100,6 +111,8 @@ pub(super) struct Share<'a> {
     parity: usize,
     /// The exchange (step, stage) whose values this share's last pass published.
     ready: Option<(u64, u32)>,
+    /// Each agent's neighbour values in turn (see `pass`).
+    scratch: Vec<Exchanged>,
 }
 
 impl<'a> Share<'a> {
@@ -119,6 +132,7 @@ impl<'a> Share<'a> {
                     agents: chunk,
                     parity: 0,
                     ready: None,
+                    scratch: Vec::new(),
                 };
                 first += len;
                 share
@@ -153,22 +167,24 @@ impl<'a> Share<'a> {
                 publish: next.is_some(),
                 check: slot.ends_step().then_some(plan.guard),
             };
-            // Read this exchange's buffer; write the next exchange's (the
-            // other one at an exchange).
-            let read = &board.published[self.parity];
+            // Read this exchange's buffer (between exchanges: the last
+            // one's); write the next exchange's (the other one).
             if slot.exchange {
                 self.parity ^= 1;
             }
+            let read = &board.published[self.parity ^ 1];
             let out = &board.published[self.parity][self.first..];
             let nbrs = &plan.nbr_index[self.first..];
+            let before = &read[self.first..];
             found = pass(
                 self.agents,
                 nbrs,
-                stage,
+                (stage, &mut self.scratch),
                 |j| read[j].load::<Judged>(),
                 |k, a| {
                     let (x, trusted) = a.stage_exchange_judged();
-                    out[k].store(&Judged(x, trusted));
+                    let held = before[k].load::<Judged>().0;
+                    out[k].store(&Judged::held(x, trusted, &held));
                 },
             );
             if let Some(x) = next {
@@ -177,6 +193,11 @@ impl<'a> Share<'a> {
         }
         self.leave(board, plan.sample_due(n + 1), found, leader.as_deref());
         board.barrier.wait();
+    }
+
+    /// Which published buffer the next exchange reads.
+    pub(super) fn parity(&self) -> usize {
+        self.parity
     }
 
     /// At a sample, `work` for each of this share's agents (network index,
@@ -202,9 +223,11 @@ impl<'a> Share<'a> {
             leader_slot.store(&Judged::of(l.stage_exchange()));
         }
         if self.ready != Some((slot.step, slot.stage)) {
-            for (cell, agent) in buffer[self.first..].iter().zip(self.agents.iter_mut()) {
+            let last = &board.published[self.parity ^ 1][self.first..];
+            let cells = buffer[self.first..].iter().zip(last);
+            for ((cell, before), agent) in cells.zip(self.agents.iter_mut()) {
                 let (x, trusted) = agent.stage_exchange_judged();
-                cell.store(&Judged(x, trusted));
+                cell.store(&Judged::held(x, trusted, &before.load::<Judged>().0));
             }
         }
         board.barrier.wait();
@@ -317,6 +340,18 @@ pub(super) fn read_states(board: &Board, states: &mut [AgentState]) {
 pub(super) fn read_peaks(board: &Board, peaks: &mut Vec<f64>) {
     peaks.clear();
     peaks.extend(board.peaks.iter().map(|slot| slot.load::<f64>()));
+}
+
+/// The caller's side after the run: the agents' published values into
+/// `published` as the one-thread step keeps them (the next exchange's
+/// first), `parity` being the buffer the next exchange reads.
+pub(super) fn read_published(board: &Board, parity: usize, published: &mut [Vec<Judged>; 2]) {
+    for (k, values) in published.iter_mut().enumerate() {
+        let buffer = &board.published[parity ^ k];
+        for (x, slot) in values.iter_mut().zip(buffer) {
+            *x = slot.load();
+        }
+    }
 }
 
 /// The caller's go-ahead after a step's end (`go_on: false` stops every

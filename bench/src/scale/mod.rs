@@ -225,7 +225,7 @@ mod tests {
     }
 
     #[test]
-    fn a_10_000_agent_tree_runs_bit_identically_on_1_and_2_threads() {
+    fn a_10_000_agent_tree_runs_bit_identically_on_1_2_and_3_threads() {
         let net = tree::network(10_000, SchemeArg::ObserverTimeVarying, 20);
         let one = trajectory(&net, 1);
         assert_eq!(one.len(), 3, "samples at t = 0, 10 and 20 steps");
@@ -233,6 +233,7 @@ mod tests {
         assert!(last.iter().all(|&b| f64::from_bits(b).is_finite()));
         assert_ne!(one[0].1, *last, "the network moved");
         assert_eq!(trajectory(&net, 2), one);
+        assert_eq!(trajectory(&net, 3), one);
     }
 
     #[test]
