@@ -28,6 +28,8 @@
 //!   [`assert_same_results`], [`staging_dir`].
 //! - `conform.rs`: [`run_conform`] (`attsync conform` of a candidate),
 //!   [`rule_line`] (one rule's verdict in its report).
+//! - `daemon.rs`: [`Daemon`], an `attsync host` in a mount namespace of its
+//!   own (private `/dev/shm`, own `TMPDIR`), [`free_port`].
 //! - `python.rs`: [`require_iceoryx2_module`], [`conform_python`] (agents
 //!   written in Python).
 //! - `variant.rs`: scenario files edited for a test: [`with_agent_lines`]
@@ -39,6 +41,7 @@
 
 mod command;
 mod conform;
+mod daemon;
 mod namespace;
 mod python;
 mod results;
@@ -49,6 +52,7 @@ mod workspace;
 
 pub use command::{Attsync, run_args};
 pub use conform::{rule_line, run_conform};
+pub use daemon::{Daemon, free_port};
 pub use namespace::{
     iox_base, kill9, node_pid, owned_run, owned_runs, run_leftovers, run_processes, signal,
 };
