@@ -4,7 +4,7 @@
 //! | code | meaning |
 //! |---|---|
 //! | 0 | success |
-//! | 2 | invalid scenario, `--set` or option, or a run this machine cannot take (nothing was started) |
+//! | 2 | invalid scenario, `--set`, hosts file or option, or a run this machine cannot take (nothing was started) |
 //! | 1 | any other error (a node died, a rule failed, a file could not be written…) |
 //! | 3 | the run diverged: a state left the envelope (`summary.json` `diverged`) |
 //! | 128 + N | interrupted by signal N: 130 SIGINT, 143 SIGTERM, 129 SIGHUP |
@@ -25,6 +25,9 @@ pub enum Error {
     /// The scenario, or a `--set`, is invalid.
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
+    /// The hosts file (`--hosts`) is invalid or does not fit the scenario.
+    #[error(transparent)]
+    Hosts(#[from] crate::hosts::HostsError),
     /// An option is out of range or does not fit the scenario.
     #[error(transparent)]
     Options(#[from] OptionError),
@@ -82,7 +85,7 @@ impl Error {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Scenario(_) | Error::Options(_) => 2,
+            Error::Scenario(_) | Error::Hosts(_) | Error::Options(_) => 2,
             Error::Run(e) => run_code(e),
             Error::RunEnd(RunEnd::Interrupted(signal)) => crate::interrupt::exit_code(*signal),
             Error::RunEnd(RunEnd::Diverged(_)) => DIVERGED,
@@ -99,13 +102,15 @@ impl Error {
         }
     }
 
-    /// Whether the message is printed as it is (a scenario error's lines
-    /// already read `FILE: FIELD: REASON`), not after `error: `.
+    /// Whether the message is printed as it is (a scenario's or a hosts
+    /// file's lines already read `FILE: FIELD: REASON`), not after `error: `.
     #[must_use]
     pub fn is_scenario(&self) -> bool {
         matches!(
             self,
             Error::Scenario(_)
+                | Error::Hosts(_)
+                | Error::Run(RunError::Hosts(_))
                 | Error::Sweep(SweepError::Scenario(_))
                 | Error::Mc(crate::mc::McError::Scenario(_))
         )
@@ -117,7 +122,7 @@ pub const DIVERGED: u8 = 3;
 
 fn run_code(e: &RunError) -> u8 {
     match e {
-        RunError::Options(_) | RunError::Capacity(_) => 2,
+        RunError::Options(_) | RunError::Capacity(_) | RunError::Hosts(_) => 2,
         _ => 1,
     }
 }

@@ -9,6 +9,8 @@
 //! - [`results`]: `errors.csv`, `summary.json`, `errors.svg`, atomic output.
 //! - [`sweep`]: one field over many values, and the bisection for the margin.
 //! - [`generate`]: generated scenarios (random trees).
+//! - [`hosts`]: placement files (`--hosts HOSTS.toml`): which machine runs
+//!   which node, and the cut edges between machines (issue 12).
 //! - [`mc`]: the Monte Carlo over initial conditions (`attsync mc`).
 //! - [`conform`]: the conformance check of a plug-in agent program.
 //! - [`verify`]: `attsync verify`, a run's files against its `manifest.json`
@@ -28,6 +30,7 @@ pub mod error;
 #[cfg(feature = "mcap")]
 pub mod export;
 pub mod generate;
+pub mod hosts;
 pub mod interrupt;
 pub mod mc;
 pub mod options;

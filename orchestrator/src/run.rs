@@ -1,6 +1,7 @@
 //! `attsync run`: a loaded scenario through an engine into a results
 //! directory.
 
+use crate::hosts::{Hosts, HostsError, Placement};
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
 use crate::outcome::Outcome;
@@ -55,6 +56,9 @@ pub struct RunOptions {
     /// Write `view.html` (`attsync run`, unless `--no-view`; not in a
     /// sweep's runs: one page per value would be most of the sweep's size).
     pub view: bool,
+    /// `--hosts`: the machines the nodes are spread over (`None`: all on
+    /// this one). Placed on the scenario before anything starts.
+    pub hosts: Option<Hosts>,
 }
 
 /// The default `--threads`: the number of cores (1 if unknown).
@@ -75,6 +79,12 @@ impl RunOptions {
         options::threads(self.threads)?;
         if let Some(f) = self.processes.realtime {
             options::realtime(f)?;
+        }
+        if self.hosts.is_some() && self.engine == Engine::InProcess {
+            return Err(OptionError::Conflict(
+                "--hosts needs --engine processes (the in-process engine runs every node in this process)"
+                    .into(),
+            ));
         }
         Ok(())
     }
@@ -109,6 +119,9 @@ pub enum RunError {
     /// Writing `view.html` failed.
     #[error(transparent)]
     View(#[from] crate::view::ViewError),
+    /// The hosts file does not fit the scenario (nothing started).
+    #[error(transparent)]
+    Hosts(#[from] HostsError),
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -139,6 +152,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let started_at = SystemTime::now();
     opts.validate()?;
     check_options(loaded, opts)?;
+    plan(loaded, opts)?;
     check_capacity(loaded, opts)?;
     let staging = Staging::claim(&opts.out).map_err(|e| match e {
         // A foreign or busy --out: refused before anything started (exit 2).
@@ -168,6 +182,17 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
 /// What [`drive`] recorded: how the run ended, the series, the in-process
 /// engine's thread count, and the frames of `view.html` (if asked for).
 type Driven = (Outcome, Vec<Series>, Option<usize>, Option<view::Frames>);
+
+/// `--hosts` placed on the scenario's network (checked before anything
+/// starts): the hosts and their nodes, or `None` for a run on this machine.
+fn plan(loaded: &Loaded, opts: &RunOptions) -> Result<Option<crate::remote::Plan>, RunError> {
+    let Some(hosts) = &opts.hosts else {
+        return Ok(None);
+    };
+    let placement = Placement::of(hosts, &loaded.resolved.network)?;
+    tracing::debug!(cut_edges = placement.cut_edges().len(), "run: placed");
+    Ok(Some(crate::remote::Plan::of(&placement)))
+}
 
 /// Runs the engine, recording every snapshot into `layout` (and the view's
 /// frames); how it ended (its failure naming the signal if interrupted),
@@ -212,6 +237,7 @@ fn drive(
         Engine::Processes => {
             let mut process_opts = opts.processes.clone();
             process_opts.plugins = loaded.resolved.plugins.clone();
+            process_opts.hosts = plan(loaded, opts)?;
             let record =
                 |snap: &attitude::engine::Snapshot<'_>| record(snap, &results::rows_of(&row, snap));
             processes::run(net, &process_opts, &layout.logs(), interrupt.flag(), record)?
@@ -473,6 +499,7 @@ mod tests {
             progress: false,
             threads: 1,
             view: false,
+            hosts: None,
         }
     }
 

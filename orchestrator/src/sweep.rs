@@ -591,6 +591,7 @@ mod tests {
                 progress: false,
                 threads: 1,
                 view: false,
+                hosts: None,
             },
             tolerance: 1e-3,
             find_margin: Some(Bisection {

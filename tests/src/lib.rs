@@ -26,10 +26,12 @@
 //! - `results.rs`: [`read`], [`assert_same_file`], [`assert_same_bytes`],
 //!   [`csv_agents`], [`csv_rows`], [`summary`], [`summary_without`],
 //!   [`assert_same_results`], [`staging_dir`].
+//! - `hosts.rs`: [`HostSandbox`], a simulated host (a mount namespace with
+//!   its own tmpfs on `/dev/shm` and its own `TMPDIR`) to start commands in
+//!   ([`HostProcess`]), its `/dev/shm` listed for leftovers; [`free_port`].
 //! - `conform.rs`: [`run_conform`] (`attsync conform` of a candidate),
 //!   [`rule_line`] (one rule's verdict in its report).
-//! - `daemon.rs`: [`Daemon`], an `attsync host` in a mount namespace of its
-//!   own (private `/dev/shm`, own `TMPDIR`), [`free_port`].
+//! - `daemon.rs`: [`Daemon`], an `attsync host` in a [`HostSandbox`] of its own.
 //! - `python.rs`: [`require_iceoryx2_module`], [`conform_python`] (agents
 //!   written in Python).
 //! - `variant.rs`: scenario files edited for a test: [`with_agent_lines`]
@@ -42,6 +44,7 @@
 mod command;
 mod conform;
 mod daemon;
+mod hosts;
 mod namespace;
 mod python;
 mod results;
@@ -52,7 +55,8 @@ mod workspace;
 
 pub use command::{Attsync, run_args};
 pub use conform::{rule_line, run_conform};
-pub use daemon::{Daemon, free_port};
+pub use daemon::Daemon;
+pub use hosts::{HostProcess, HostSandbox, free_port};
 pub use namespace::{
     iox_base, kill9, node_pid, owned_run, owned_runs, run_leftovers, run_processes, signal,
 };

@@ -300,6 +300,7 @@ pub fn trial_alone(
         progress: o.progress,
         threads: 1,
         view: true,
+        hosts: None,
     };
     let summary = crate::run::run(&prepared.loaded, &opts, interrupt)?;
     if let Some(signal) = interrupt.signal() {

@@ -26,6 +26,19 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The hosts of `p` (HOSTS.toml placed on a network) and their nodes.
+    #[must_use]
+    pub fn of(p: &crate::hosts::Placement) -> Self {
+        let hosts = (p.hosts().iter().enumerate())
+            .map(|(i, h)| PlannedHost {
+                name: h.name.clone(),
+                endpoint: h.endpoint.clone(),
+                nodes: p.nodes_on(i).to_vec(),
+            })
+            .collect();
+        Self { hosts }
+    }
+
     /// Where node `id` runs.
     #[must_use]
     pub fn side_of(&self, id: u32) -> Side {

@@ -126,11 +126,17 @@ pub(super) fn deserialize_tree(tree: &stream::Table<'_>) -> Result<Scenario, Vec
 /// deserializer, on a copy). [`deserialize`] gives the same result, faster
 /// on a valid document.
 pub fn collect(doc: &Table) -> Result<Scenario, Vec<Problem>> {
+    collect_as(doc)
+}
+
+/// `doc` as a `T` (any file format of attsync's, e.g. a hosts file), or
+/// every problem found (at most [`MAX_PROBLEMS`]), as [`collect`] does.
+pub fn collect_as<T: serde::de::DeserializeOwned>(doc: &Table) -> Result<T, Vec<Problem>> {
     let mut copy = doc.clone();
     let mut removed = Removed::default();
     let mut problems = Vec::new();
     while problems.len() < MAX_PROBLEMS {
-        let e = match serde_path_to_error::deserialize::<_, Scenario>(Value::Table(copy.clone())) {
+        let e = match serde_path_to_error::deserialize::<_, T>(Value::Table(copy.clone())) {
             Ok(s) if problems.is_empty() => return Ok(s),
             Ok(_) => break,
             Err(e) => e,

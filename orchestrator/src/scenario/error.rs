@@ -46,7 +46,8 @@ pub enum ScenarioError {
     },
 }
 
-fn fmt_issues(file: &Path, issues: &[Issue]) -> String {
+/// `issues` of `file`, one line each as `FILE: FIELD: REASON`.
+pub(crate) fn fmt_issues(file: &Path, issues: &[Issue]) -> String {
     issues
         .iter()
         .map(|i| format!("{}: {i}", file.display()))

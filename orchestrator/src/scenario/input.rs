@@ -18,15 +18,18 @@ pub enum ReadError {
     /// The OS refused to open or read it.
     #[error("cannot read: {0}")]
     Io(std::io::Error),
-    /// It is over [`MAX_FILE_BYTES`]; `size` is `None` when the file has no
-    /// size (a pipe or a device) and more than the limit was read.
-    #[error("{} is over the limit of {MAX_FILE_BYTES} bytes (256 MiB) for a scenario file", match size {
+    /// It is over its limit ([`MAX_FILE_BYTES`] for a scenario); `size` is
+    /// `None` when the file has no size (a pipe or a device) and more than
+    /// the limit was read.
+    #[error("{} is over the limit of {} bytes ({} MiB) for {}", match size {
         Some(n) => format!("its size, {n} bytes,"),
-        None => format!("its content, more than {MAX_FILE_BYTES} bytes,"),
-    })]
+        None => format!("its content, more than {} bytes,", limit.bytes),
+    }, limit.bytes, limit.bytes >> 20, limit.what)]
     TooLarge {
         /// The size from the file's metadata, if it has one.
         size: Option<u64>,
+        /// The limit it is over.
+        limit: Limit,
     },
     /// It is not UTF-8 text.
     #[error("not UTF-8 text (invalid byte at offset {offset})")]
@@ -36,15 +39,36 @@ pub enum ReadError {
     },
 }
 
+/// A size limit on a file read, and what kind of file it is for messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limit {
+    /// The most bytes accepted.
+    pub bytes: u64,
+    /// The kind of file, e.g. "a scenario file".
+    pub what: &'static str,
+}
+
+/// The limit of a scenario file: [`MAX_FILE_BYTES`].
+pub const SCENARIO: Limit = Limit {
+    bytes: MAX_FILE_BYTES,
+    what: "a scenario file",
+};
+
 /// The text of `file`, refused without reading when its metadata says it
 /// is over [`MAX_FILE_BYTES`], and never reading more than that plus one byte.
 pub fn read_bounded(file: &Path) -> Result<String, ReadError> {
+    read_limited(file, SCENARIO)
+}
+
+/// As [`read_bounded`], within `limit`.
+pub fn read_limited(file: &Path, limit: Limit) -> Result<String, ReadError> {
     let f = std::fs::File::open(file).map_err(ReadError::Io)?;
     let meta = f.metadata().map_err(ReadError::Io)?;
     let hint = if meta.is_file() {
-        if meta.len() > MAX_FILE_BYTES {
+        if meta.len() > limit.bytes {
             return Err(ReadError::TooLarge {
                 size: Some(meta.len()),
+                limit,
             });
         }
         meta.len()
@@ -52,12 +76,13 @@ pub fn read_bounded(file: &Path) -> Result<String, ReadError> {
         0
     };
     let mut bytes = Vec::with_capacity(usize::try_from(hint).unwrap_or(0) + 1);
-    f.take(MAX_FILE_BYTES + 1)
+    f.take(limit.bytes + 1)
         .read_to_end(&mut bytes)
         .map_err(ReadError::Io)?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
+    if bytes.len() as u64 > limit.bytes {
         return Err(ReadError::TooLarge {
             size: meta.is_file().then_some(bytes.len() as u64),
+            limit,
         });
     }
     String::from_utf8(bytes).map_err(|e| ReadError::NotUtf8 {

@@ -29,7 +29,7 @@ mod document;
 mod error;
 pub mod input;
 pub mod overrides;
-mod parse;
+pub(crate) mod parse;
 pub mod plugin;
 pub mod report;
 pub mod resolve;
@@ -38,6 +38,7 @@ mod stream;
 
 pub use document::Document;
 pub use error::ScenarioError;
+pub(crate) use error::fmt_issues;
 pub use resolve::{Issue, Resolved};
 pub use schema::Scenario;
 

@@ -10,6 +10,7 @@ use super::overrides;
 use super::resolve::Issue;
 use super::schema::Scenario;
 use super::stream;
+use serde::de::DeserializeOwned;
 use std::time::Instant;
 use toml::Table;
 use toml::de::{DeArray, DeTable};
@@ -50,18 +51,31 @@ pub(super) fn parse(text: &str, sets: &[String]) -> Result<Scenario, Failure> {
             overrides: bad,
             schema: Vec::new(),
         }),
-        Err(problems) => {
-            let spans = DeTable::parse(text).ok();
-            let schema = problems
-                .iter()
-                .map(|p| issue(text, spans.as_ref().map(|s| s.get_ref()), &applied, p))
-                .collect();
-            Err(Failure::Schema {
-                overrides: bad,
-                schema,
-            })
-        }
+        Err(problems) => Err(Failure::Schema {
+            overrides: bad,
+            schema: located(text, &applied, &problems),
+        }),
     }
+}
+
+/// `text` (TOML, without overrides) as a `T` — another of attsync's files,
+/// e.g. a hosts file — or its syntax error, or every schema problem, each
+/// located in the text as a scenario's are.
+pub(crate) fn typed<T: DeserializeOwned>(text: &str) -> Result<T, Vec<Issue>> {
+    let table: Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| vec![syntax(text, &e)])?;
+    deserialize::collect_as(&table).map_err(|problems| located(text, &[], &problems))
+}
+
+/// Each schema problem as an issue, located in `text` unless an override
+/// (of `applied`) set its field.
+fn located(text: &str, applied: &[&str], problems: &[Problem]) -> Vec<Issue> {
+    let spans = DeTable::parse(text).ok();
+    problems
+        .iter()
+        .map(|p| issue(text, spans.as_ref().map(|s| s.get_ref()), applied, p))
+        .collect()
 }
 
 /// The effective document (read by [`stream`], else by toml's parser, which

@@ -192,6 +192,7 @@ fn options(
         threads: m.threads.unwrap_or_else(run::default_threads),
         // The re-run is compared by states.bin and errors.csv only.
         view: false,
+        hosts: None,
     })
 }
 

@@ -3,10 +3,12 @@
 
 use super::ScenarioArgs;
 use attsync::Error;
+use attsync::hosts::{self, Placement};
 use attsync::options::StiffnessCheck;
 use attsync::processes::{self, ProcessOptions};
+use std::path::PathBuf;
 
-/// `attsync check SCENARIO [--set K=V]… [--node-config ID] [--no-stiffness-check]`.
+/// `attsync check SCENARIO [--set K=V]… [--hosts FILE] [--node-config ID] [--no-stiffness-check]`.
 #[derive(Debug, clap::Args)]
 pub struct Check {
     #[command(flatten)]
@@ -19,15 +21,28 @@ pub struct Check {
     /// the scenario's loops (docs/stiffness.md): warn, and run anyway.
     #[arg(long)]
     pub no_stiffness_check: bool,
+    /// Also print where the nodes would run across machines: each host of
+    /// this placement file (HOSTS.toml), the local nodes, the cut edges.
+    #[arg(long, value_name = "HOSTS.toml", conflicts_with = "node_config")]
+    pub hosts: Option<PathBuf>,
 }
 
-/// Prints the network, or node `--node-config`'s configuration.
+/// Prints the network (and its placement, `--hosts`), or node
+/// `--node-config`'s configuration. A bad hosts file is refused first.
 pub fn exec(a: Check) -> Result<(), Error> {
+    let hosts = a.hosts.as_deref().map(hosts::load).transpose()?;
     let loaded = a
         .scenario
         .load(StiffnessCheck::from_flag(a.no_stiffness_check))?;
     let Some(id) = a.node_config else {
+        let placement = hosts
+            .as_ref()
+            .map(|h| Placement::of(h, &loaded.resolved.network))
+            .transpose()?;
         print!("{}", attsync::scenario::report::describe(&loaded));
+        if let (Some(h), Some(p)) = (&hosts, &placement) {
+            print!("{}", hosts::report::describe(&h.path, p));
+        }
         // The process ends here: freeing a large scenario's tables one by
         // one (~4 % of `check` at 10⁴ agents) is left to the OS.
         std::mem::forget(loaded);

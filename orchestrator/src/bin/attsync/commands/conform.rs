@@ -3,6 +3,7 @@
 use super::SetArgs;
 use attsync::Error;
 use attsync::conform::{self, ConformOptions, LawMode};
+use attsync::options::OptionError;
 use std::path::PathBuf;
 
 /// `attsync conform [--scenario F] [--agent ID] [--set K=V]… -- COMMAND…`.
@@ -31,6 +32,10 @@ pub struct Conform {
     /// Where the candidate's output goes [default: a file in the temp directory].
     #[arg(long)]
     pub log: Option<PathBuf>,
+    /// Not accepted: conform runs one candidate on this machine only, against
+    /// a neighbourhood in attsync's own process (exit 2).
+    #[arg(long, value_name = "HOSTS.toml")]
+    pub hosts: Option<PathBuf>,
     /// The candidate program and its arguments (after `--`).
     #[arg(last = true, required = true, value_name = "COMMAND")]
     pub command: Vec<String>,
@@ -48,6 +53,14 @@ pub enum LawArg {
 /// Checks the candidate and prints one verdict per rule; fails unless every
 /// rule passes.
 pub fn exec(a: Conform) -> Result<(), Error> {
+    if a.hosts.is_some() {
+        return Err(OptionError::Conflict(
+            "--hosts: conform runs one candidate on this machine only (its neighbourhood runs in \
+             attsync's own process); run it on the machine the candidate will run on"
+                .into(),
+        )
+        .into());
+    }
     let log = a.log.unwrap_or_else(|| {
         std::env::temp_dir().join(format!("attsync-conform-{}.log", std::process::id()))
     });

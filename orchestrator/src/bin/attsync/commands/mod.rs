@@ -13,6 +13,7 @@ mod verify;
 mod view;
 
 use attsync::Error;
+use attsync::hosts::Hosts;
 use attsync::interrupt::Interrupt;
 use attsync::processes::ProcessOptions;
 use attsync::processes::placement::Placement;
@@ -107,6 +108,28 @@ impl ScenarioArgs {
             &self.overrides.set,
             check,
         )?)
+    }
+}
+
+/// `--hosts`, shared by `run` and `sweep` (every run of a sweep the same).
+#[derive(Debug, Clone, clap::Args)]
+pub struct HostsArgs {
+    /// Spread the nodes over machines as this placement file says
+    /// (HOSTS.toml: [[host]] name, endpoint, agents, leader; README "Across
+    /// machines"); nodes on no host run on this machine. Processes engine.
+    #[arg(long, value_name = "HOSTS.toml")]
+    pub hosts: Option<PathBuf>,
+}
+
+impl HostsArgs {
+    /// The hosts file, loaded and checked on its own (a bad one: exit 2,
+    /// before anything else).
+    pub fn load(&self) -> Result<Option<Hosts>, Error> {
+        Ok(self
+            .hosts
+            .as_deref()
+            .map(attsync::hosts::load)
+            .transpose()?)
     }
 }
 

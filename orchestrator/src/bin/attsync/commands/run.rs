@@ -1,6 +1,6 @@
 //! `attsync run`: a scenario through an engine into a results directory.
 
-use super::{EngineArgs, ScenarioArgs};
+use super::{EngineArgs, HostsArgs, ScenarioArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::options::StiffnessCheck;
@@ -9,14 +9,16 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// `attsync run SCENARIO [--engine E] [--wait W] [--stage-timeout S]
-/// [--realtime [FACTOR]] [--threads N] [--out DIR] [--set K=V]… [--quiet]
-/// [--no-stiffness-check] [--no-view]`.
+/// [--realtime [FACTOR]] [--threads N] [--hosts HOSTS.toml] [--out DIR]
+/// [--set K=V]… [--quiet] [--no-stiffness-check] [--no-view]`.
 #[derive(Debug, clap::Args)]
 pub struct Run {
     #[command(flatten)]
     pub scenario: ScenarioArgs,
     #[command(flatten)]
     pub engine: EngineArgs,
+    #[command(flatten)]
+    pub hosts: HostsArgs,
     /// Real-time mode: nodes run free against the wall clock at FACTOR
     /// simulated seconds per wall second [default FACTOR: 1], never wait for
     /// their inputs, and the links' measured age of information is reported.
@@ -47,6 +49,7 @@ pub struct Run {
 /// Runs the scenario, prints its summary; an incomplete run is an error
 /// (its results are kept).
 pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
+    let hosts = a.hosts.load()?;
     let mut opts = RunOptions {
         engine: a.engine.engine,
         out: a.out.clone().unwrap_or_default(),
@@ -54,6 +57,7 @@ pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
         progress: !a.quiet && std::io::stderr().is_terminal(),
         threads: a.threads.unwrap_or_else(run::default_threads),
         view: !a.no_view,
+        hosts,
     };
     opts.validate()?;
     let loaded = a

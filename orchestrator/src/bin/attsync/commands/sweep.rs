@@ -1,7 +1,7 @@
 //! `attsync sweep`: one field of a scenario over many values, in parallel,
 //! and optionally the bisection for the margin.
 
-use super::{EngineArgs, ScenarioArgs};
+use super::{EngineArgs, HostsArgs, ScenarioArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::options::StiffnessCheck;
@@ -28,6 +28,8 @@ pub struct Sweep {
     pub threads: Option<usize>,
     #[command(flatten)]
     pub engine: EngineArgs,
+    #[command(flatten)]
+    pub hosts: HostsArgs,
     /// Sweep directory [default: results/<scenario name>-sweep-<param>].
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -51,6 +53,7 @@ pub struct Sweep {
 
 /// Runs the sweep and prints its table.
 pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
+    let hosts = a.hosts.load()?;
     let (jobs, threads) = sweep::jobs_and_threads(a.jobs, a.threads);
     let mut o = SweepOptions {
         scenario: a.scenario.scenario.clone(),
@@ -65,6 +68,7 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
             progress: false,
             threads,
             view: false,
+            hosts,
         },
         tolerance: a.tolerance,
         find_margin: a.find_margin.then_some(Bisection {
@@ -75,6 +79,10 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
     };
     o.validate()?;
     let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
+    if let Some(h) = &o.run.hosts {
+        // Every run places its own scenario again; the base, before any starts.
+        attsync::hosts::Placement::of(h, &base.resolved.network)?;
+    }
     if let Some(w) = base.resolved.law_warning() {
         eprintln!("warning: {}: {w}", base.file.display());
     }
