@@ -3,8 +3,10 @@
 //! nothing can pass between hosts through shared memory; Zenoh over
 //! 127.0.0.1 only, on a free port. Killed when dropped.
 
+use crate::command::{Attsync, run_args};
 use crate::hosts::{HostProcess, HostSandbox, free_port};
 use crate::workspace::bin;
+use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus};
 use std::time::Duration;
 
@@ -107,6 +109,52 @@ impl Daemon {
             .as_ref()
             .map(HostProcess::stderr)
             .unwrap_or_default()
+    }
+}
+
+/// Writes `dir/name`, a HOSTS.toml placing on each `(daemon, leader,
+/// agents)` the leader (if `leader`) and `agents`.
+#[must_use]
+pub fn hosts_file(dir: &Path, name: &str, hosts: &[(&Daemon, bool, &[u32])]) -> PathBuf {
+    let mut text = String::new();
+    for (d, leader, agents) in hosts {
+        text.push_str(&format!(
+            "[[host]]\nname = \"{}\"\nendpoint = \"{}\"\nleader = {leader}\nagents = {agents:?}\n\n",
+            d.name(),
+            d.endpoint
+        ));
+    }
+    let file = dir.join(name);
+    std::fs::write(&file, text).expect("HOSTS.toml");
+    file
+}
+
+/// `attsync run SCENARIO --engine processes --out OUT --quiet --set S…
+/// --hosts HOSTS`, in `cwd`.
+#[must_use]
+pub fn run_on_hosts(
+    cwd: &Path,
+    scenario: &Path,
+    out: &Path,
+    sets: &[&str],
+    hosts: &Path,
+) -> Attsync {
+    Attsync::new(cwd)
+        .args(run_args(scenario, "processes", out, sets))
+        .args(["--hosts".as_ref(), hosts.as_os_str()])
+}
+
+/// Asserts no daemon of `daemons` kept anything of its runs ([`Daemon::leftovers`]).
+#[track_caller]
+pub fn assert_hosts_clean(daemons: &[&Daemon]) {
+    for d in daemons {
+        let left = d.leftovers();
+        assert!(
+            left.is_empty(),
+            "host {} kept {left:?}\n{}",
+            d.name(),
+            d.log()
+        );
     }
 }
 

@@ -4,31 +4,17 @@
 //! the in-process engine; nothing left on any host; a daemon serves one
 //! run after another and two runs at once.
 
-use attsync_tests::{Attsync, Daemon, Sandbox, assert_same_results, paper, run_args, summary};
-use std::path::{Path, PathBuf};
+use attsync_tests::{
+    Attsync, Daemon, Sandbox, assert_hosts_clean, assert_same_results, hosts_file, paper, run_args,
+    run_on_hosts, summary,
+};
+use std::path::Path;
 
 const TWO_SECONDS: &str = "simulation.duration=2";
 
-/// A HOSTS.toml placing `(daemon, leader, agents)`.
-fn hosts_file(tmp: &Sandbox, name: &str, hosts: &[(&Daemon, bool, &[u32])]) -> PathBuf {
-    let mut text = String::new();
-    for (d, leader, agents) in hosts {
-        text.push_str(&format!(
-            "[[host]]\nname = \"{}\"\nendpoint = \"{}\"\nleader = {leader}\nagents = {agents:?}\n\n",
-            d.name(),
-            d.endpoint
-        ));
-    }
-    let file = tmp.join(name);
-    std::fs::write(&file, text).expect("HOSTS.toml");
-    file
-}
-
 /// Runs `scenario` over `hosts` into `out`, asserting success.
 fn run_over(tmp: &Sandbox, scenario: &Path, hosts: &Path, out: &Path) {
-    Attsync::new(tmp.path())
-        .args(run_args(scenario, "processes", out, &[TWO_SECONDS]))
-        .args(["--hosts".as_ref(), hosts.as_os_str()])
+    run_on_hosts(tmp.path(), scenario, out, &[TWO_SECONDS], hosts)
         .output()
         .assert_ok()
         .assert_no_leftovers();
@@ -43,24 +29,11 @@ fn reference(tmp: &Sandbox, scenario: &Path, out: &Path) {
         .assert_ok();
 }
 
-/// Asserts every daemon left nothing of its runs.
-fn assert_clean(daemons: &[&Daemon]) {
-    for d in daemons {
-        let left = d.leftovers();
-        assert!(
-            left.is_empty(),
-            "host {} kept {left:?}\n{}",
-            d.name(),
-            d.log()
-        );
-    }
-}
-
 #[test]
 fn timevarying_with_agents_on_one_host_is_byte_identical() {
     let tmp = Sandbox::new("hosts-tv");
     let a = Daemon::start("a", &[]);
-    let hosts = hosts_file(&tmp, "hosts.toml", &[(&a, false, &[2, 3])]);
+    let hosts = hosts_file(tmp.path(), "hosts.toml", &[(&a, false, &[2, 3])]);
     let (p, i) = (tmp.join("hosts"), tmp.join("in-process"));
     run_over(&tmp, &paper("timevarying"), &hosts, &p);
     reference(&tmp, &paper("timevarying"), &i);
@@ -68,7 +41,7 @@ fn timevarying_with_agents_on_one_host_is_byte_identical() {
     // The remote nodes' logs came back.
     let log = std::fs::read_to_string(p.join("logs/agent-2.log")).expect("agent-2's log");
     assert!(log.contains("done"), "{log}");
-    assert_clean(&[&a]);
+    assert_hosts_clean(&[&a]);
 }
 
 #[test]
@@ -78,7 +51,7 @@ fn the_three_schemes_over_three_hosts_are_byte_identical_and_the_daemons_serve_r
     let b = Daemon::start("b", &[&a]);
     let c = Daemon::start("c", &[&a, &b]);
     let hosts = hosts_file(
-        &tmp,
+        tmp.path(),
         "hosts.toml",
         &[
             (&a, true, &[1, 2]),
@@ -91,7 +64,7 @@ fn the_three_schemes_over_three_hosts_are_byte_identical_and_the_daemons_serve_r
         run_over(&tmp, &paper(scheme), &hosts, &p);
         reference(&tmp, &paper(scheme), &i);
         assert_same_results(&p, &i);
-        assert_clean(&[&a, &b, &c]);
+        assert_hosts_clean(&[&a, &b, &c]);
     }
 }
 
@@ -101,7 +74,7 @@ fn two_runs_at_once_on_the_same_daemons_are_isolated() {
     let a = Daemon::start("a", &[]);
     let b = Daemon::start("b", &[&a]);
     let hosts = hosts_file(
-        &tmp,
+        tmp.path(),
         "hosts.toml",
         &[(&a, true, &[1, 3, 5]), (&b, false, &[2, 4])],
     );
@@ -109,10 +82,7 @@ fn two_runs_at_once_on_the_same_daemons_are_isolated() {
     let runs: Vec<_> = (0..2)
         .map(|k| {
             let out = tmp.join(format!("run-{k}"));
-            let running = Attsync::new(tmp.path())
-                .args(run_args(&scheme, "processes", &out, &[TWO_SECONDS]))
-                .args(["--hosts".as_ref(), hosts.as_os_str()])
-                .spawn();
+            let running = run_on_hosts(tmp.path(), &scheme, &out, &[TWO_SECONDS], &hosts).spawn();
             (out, running)
         })
         .collect();
@@ -122,5 +92,5 @@ fn two_runs_at_once_on_the_same_daemons_are_isolated() {
         running.wait(attsync_tests::RUN_TIMEOUT).assert_ok();
         assert_same_results(&out, &i);
     }
-    assert_clean(&[&a, &b]);
+    assert_hosts_clean(&[&a, &b]);
 }
