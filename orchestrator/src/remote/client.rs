@@ -239,6 +239,7 @@ impl Remote {
     pub fn control(&self, m: ControlMsg) -> Result<(), String> {
         (self.session.put(keys::control(&self.run), m.to_bytes()))
             .congestion_control(zenoh::qos::CongestionControl::Block)
+            .express(true)
             .wait()
             .map_err(zerr)
     }

@@ -5,6 +5,9 @@
 //! back across hosts as iceoryx2's subscriber buffer holds it on one, and
 //! the receiver's queue never fills (a full queue would stall its session).
 //!
+//! Every message goes out at once (`express`: not held back to be batched;
+//! lockstep waits for each one, so its latency is the run's pace).
+//!
 //! Readiness: the receiver declares its subscriber, then acknowledges
 //! (count 0) every [`HELLO_EVERY`] until data flows; the sender sends nothing
 //! before its first acknowledgement, so no message is put before the other
@@ -79,6 +82,7 @@ impl LinkSender {
         let publisher = session
             .declare_publisher(key.to_string())
             .congestion_control(CongestionControl::Block)
+            .express(true)
             .wait()
             .map_err(zerr)?;
         let acked: Acked = Arc::new((Mutex::new(None), Condvar::new()));
@@ -183,6 +187,7 @@ impl LinkReceiver {
         let acks = session
             .declare_publisher(super::keys::ack(key))
             .congestion_control(CongestionControl::Block)
+            .express(true)
             .wait()
             .map_err(zerr)?;
         let r = Self {
