@@ -9,12 +9,14 @@
 //! # Layout
 //! - [`payload`]: [`StateMsg`], [`ControlMsg`], [`PROTOCOL_VERSION`].
 //! - [`telemetry`]: [`Telemetry`] (what a node reports) and its wire form [`TelemetryMsg`], encoded and decoded side by side.
+//! - [`bytes`]: the payloads as little-endian bytes, for the bridge across hosts.
 //! - [`config`]: the JSON configuration each node process receives.
 //! - [`names`]: service names under `attsync/<run>/…`.
 //! - [`open`]: the openers, with limits derived from the topology ([`Limits`]).
 //! - [`namespace`]: the per-run iceoryx2 configuration (file prefix, root path).
 //! - [`iox`]: [`IoxError`](iox::IoxError) for any failed iceoryx2 call; [`create_node`](iox::create_node) in a run's namespace.
 
+pub mod bytes;
 pub mod config;
 pub mod iox;
 pub mod names;

@@ -72,6 +72,9 @@ pub enum Error {
     /// The signal handler could not be installed.
     #[error("installing the signal handler: {0}")]
     Signals(std::io::Error),
+    /// `attsync host` could not start or serve.
+    #[error("attsync host: {0}")]
+    Host(#[from] crate::remote::daemon::HostError),
     /// A run directory's `view.html` could not be made (`attsync view`).
     #[error(transparent)]
     View(#[from] crate::view::ViewError),
@@ -94,6 +97,7 @@ impl Error {
                 _ => 1,
             },
             Error::Mc(e) => e.exit_code(),
+            Error::Host(e) => e.exit_code(),
             _ => 1,
         }
     }

@@ -36,6 +36,7 @@ pub mod mc;
 pub mod options;
 pub mod outcome;
 pub mod processes;
+pub mod remote;
 pub mod results;
 pub mod run;
 pub mod scenario;

@@ -122,11 +122,6 @@ pub enum RunError {
     /// The hosts file does not fit the scenario (nothing started).
     #[error(transparent)]
     Hosts(#[from] HostsError),
-    /// A run across machines was asked for; this build cannot carry one
-    /// yet (a temporary state of the `hostsfile` branch: the host daemons
-    /// and the bridge replace it).
-    #[error("multi-host runs need the host daemons (not built in this commit)")]
-    NoHostDaemons,
     /// Drawing the plot failed.
     #[error("{path}: cannot draw plot: {message}")]
     Plot {
@@ -157,11 +152,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let started_at = SystemTime::now();
     opts.validate()?;
     check_options(loaded, opts)?;
-    if let Some(hosts) = &opts.hosts {
-        let placement = Placement::of(hosts, &loaded.resolved.network)?;
-        tracing::debug!(cut_edges = placement.cut_edges().len(), "run: placed");
-        return Err(RunError::NoHostDaemons);
-    }
+    plan(loaded, opts)?;
     check_capacity(loaded, opts)?;
     let staging = Staging::claim(&opts.out).map_err(|e| match e {
         // A foreign or busy --out: refused before anything started (exit 2).
@@ -191,6 +182,17 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
 /// What [`drive`] recorded: how the run ended, the series, the in-process
 /// engine's thread count, and the frames of `view.html` (if asked for).
 type Driven = (Outcome, Vec<Series>, Option<usize>, Option<view::Frames>);
+
+/// `--hosts` placed on the scenario's network (checked before anything
+/// starts): the hosts and their nodes, or `None` for a run on this machine.
+fn plan(loaded: &Loaded, opts: &RunOptions) -> Result<Option<crate::remote::Plan>, RunError> {
+    let Some(hosts) = &opts.hosts else {
+        return Ok(None);
+    };
+    let placement = Placement::of(hosts, &loaded.resolved.network)?;
+    tracing::debug!(cut_edges = placement.cut_edges().len(), "run: placed");
+    Ok(Some(crate::remote::Plan::of(&placement)))
+}
 
 /// Runs the engine, recording every snapshot into `layout` (and the view's
 /// frames); how it ended (its failure naming the signal if interrupted),
@@ -235,6 +237,7 @@ fn drive(
         Engine::Processes => {
             let mut process_opts = opts.processes.clone();
             process_opts.plugins = loaded.resolved.plugins.clone();
+            process_opts.hosts = plan(loaded, opts)?;
             let record =
                 |snap: &attitude::engine::Snapshot<'_>| record(snap, &results::rows_of(&row, snap));
             processes::run(net, &process_opts, &layout.logs(), interrupt.flag(), record)?

@@ -31,6 +31,8 @@
 //!   ([`HostProcess`]), its `/dev/shm` listed for leftovers; [`free_port`].
 //! - `conform.rs`: [`run_conform`] (`attsync conform` of a candidate),
 //!   [`rule_line`] (one rule's verdict in its report).
+//! - `daemon.rs`: [`Daemon`], an `attsync host` in a [`HostSandbox`] of its own;
+//!   [`hosts_file`] (a HOSTS.toml of daemons), [`run_on_hosts`], [`assert_hosts_clean`].
 //! - `python.rs`: [`require_iceoryx2_module`], [`conform_python`] (agents
 //!   written in Python).
 //! - `variant.rs`: scenario files edited for a test: [`with_agent_lines`]
@@ -42,6 +44,7 @@
 
 mod command;
 mod conform;
+mod daemon;
 mod hosts;
 mod namespace;
 mod python;
@@ -53,6 +56,7 @@ mod workspace;
 
 pub use command::{Attsync, run_args};
 pub use conform::{rule_line, run_conform};
+pub use daemon::{Daemon, assert_hosts_clean, hosts_file, run_on_hosts};
 pub use hosts::{HostProcess, HostSandbox, free_port};
 pub use namespace::{
     iox_base, kill9, node_pid, owned_run, owned_runs, run_leftovers, run_processes, signal,

@@ -27,6 +27,26 @@ impl Session<'_> {
         None
     }
 
+    /// A lost host, a host's failure, or a node on a host that exited
+    /// before it was done (named with its host, status and log's end).
+    pub(super) fn remote_ended_early(&mut self) -> Result<Option<Failure>, Failure> {
+        let Some(r) = &self.remote else {
+            return Ok(None);
+        };
+        for e in r.check()? {
+            let Some(slot) = self.nodes.slots.iter().find(|s| s.id == e.id) else {
+                continue;
+            };
+            if !(slot.done && e.clean) {
+                return Ok(Some(format!(
+                    "{} ended during the run ({}); last lines of its log (logs/{}.log in the results directory):\n{}",
+                    slot.label, e.status, slot.name, e.tail
+                )));
+            }
+        }
+        Ok(None)
+    }
+
     /// `failure`, with the nodes others gave up waiting for named first.
     /// The last reports may come a little after the first failure (a node
     /// held back by a silent receiver gives up when its back-pressure wait

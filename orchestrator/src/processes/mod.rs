@@ -68,6 +68,8 @@ pub struct ProcessOptions {
     pub plugins: Vec<Plugin>,
     /// Where the node processes run ([`placement::Placement`]).
     pub placement: placement::Placement,
+    /// Nodes placed on other hosts (`run --hosts`), if any.
+    pub hosts: Option<crate::remote::Plan>,
 }
 
 impl Default for ProcessOptions {
@@ -79,6 +81,7 @@ impl Default for ProcessOptions {
             realtime: None,
             plugins: Vec::new(),
             placement: placement::Placement::Auto,
+            hosts: None,
         }
     }
 }
@@ -95,6 +98,9 @@ pub enum ProcessError {
     /// A service of the run could not be opened.
     #[error("iceoryx2: {0}")]
     Open(#[from] OpenError),
+    /// A host of the run cannot be reached or used.
+    #[error("{0}")]
+    Remote(String),
     /// A file could not be written.
     #[error("{path}: {source}")]
     Io {
@@ -122,6 +128,9 @@ struct Session<'a> {
     interrupt: &'a AtomicBool,
     /// `attsync-agent` and `attsync-leader`.
     binaries: (PathBuf, PathBuf),
+    /// The hosts of a run placed over several machines (dropped before the
+    /// ports: its bridges use the namespace).
+    remote: Option<crate::remote::Remote>,
     /// Dropped before the supervisor: the namespace goes first, as it always did.
     ports: Ports,
     sup: Supervisor,
@@ -148,10 +157,11 @@ pub fn run(
         "processes: ports open, spawning"
     );
     s.spawn_nodes()?;
+    let remote_started = s.start_remote();
     let placer = placement::Placer::start(opts.placement, s.sup.pids().to_vec());
     tracing::debug!("processes: spawned, waiting for Ready");
-    let failure = s
-        .await_ready()
+    let failure = remote_started
+        .and_then(|()| s.await_ready())
         .and_then(|()| {
             tracing::debug!("processes: all ready, Start");
             s.start()

@@ -4,6 +4,7 @@
 
 use super::supervise::describe;
 use super::{Failure, Session};
+use msgs::{ControlCommand, ControlMsg};
 use std::time::Duration;
 
 /// Longest wait for the nodes to exit after `Stop`.
@@ -18,16 +19,30 @@ impl Session<'_> {
         if failure.is_some() {
             self.sup.kill_all();
             let _ = self.sup.wait_all(KILL_TIMEOUT);
+            if let Some(r) = self.remote.as_mut() {
+                r.finish(true, self.logs);
+            }
             return failure;
         }
         let _ = self.ports.stop();
-        let bad: Vec<String> = (self.sup.wait_all(STOP_TIMEOUT).iter())
+        if let Some(r) = &self.remote {
+            let _ = r.control(ControlMsg::new(ControlCommand::Stop));
+        }
+        let mut bad: Vec<String> = (self.sup.wait_all(STOP_TIMEOUT).iter())
             .filter(|e| !matches!(&e.status, Ok(s) if s.success()))
             .map(|e| {
                 let label = &self.nodes.slots[e.index].label;
                 format!("{label}: {}", describe(&e.status))
             })
             .collect();
+        if let Some(r) = self.remote.as_mut() {
+            for e in r.finish(false, self.logs) {
+                let label = (self.nodes.slots.iter())
+                    .find(|s| s.id == e.id)
+                    .map_or_else(|| format!("host {}", e.host), |s| s.label.clone());
+                bad.push(format!("{label}: {}", e.status));
+            }
+        }
         (!bad.is_empty()).then(|| format!("nodes failed at shutdown: {}", bad.join("; ")))
     }
 }

@@ -5,11 +5,11 @@
 use super::collect::{Collector, NodeSlot};
 use super::configs::{node_configs, node_id, node_label, node_name, plugin_of};
 use super::namespace::{self, Namespace};
-use super::supervise::{Supervisor, find_binaries};
+use super::supervise::{Launch, Supervisor, find_binaries};
 use super::{Failure, ProcessError, ProcessOptions, Session, io_at};
 use attitude::network::Network;
 use iceoryx2::service::port_factory::PortFactory;
-use msgs::Limits;
+use msgs::{ControlCommand, ControlMsg, Limits};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -36,9 +36,16 @@ impl<'a> Session<'a> {
         let ids: Vec<u32> = (0..n_nodes).map(|i| node_id(net, i)).collect();
         let ports = super::Ports::open(ns, "orchestrator", &Limits::of(net), &ids)?;
         let sup = Supervisor::new().map_err(io_at(Path::new("tokio runtime")))?;
+        let remote = (opts.hosts.as_ref())
+            .map(|plan| crate::remote::Remote::connect(plan, ports.run()))
+            .transpose()
+            .map_err(ProcessError::Remote)?;
         let slots = (0..n_nodes)
             .map(|i| {
-                let label = node_label(net, &opts.plugins, i);
+                let mut label = node_label(net, &opts.plugins, i);
+                if let Some(h) = remote.as_ref().and_then(|r| r.host_of(ids[i])) {
+                    label = format!("{label} on host {h}");
+                }
                 NodeSlot::new(node_name(net, i), label, ids[i])
             })
             .collect();
@@ -48,6 +55,7 @@ impl<'a> Session<'a> {
             logs,
             interrupt,
             binaries,
+            remote,
             ports,
             sup,
             nodes: Collector::new(slots),
@@ -67,29 +75,26 @@ impl<'a> Session<'a> {
         let (agent_bin, leader_bin) = self.binaries.clone();
         let configs = node_configs(self.net, self.ports.run(), self.ports.dir(), self.opts);
         for (i, c) in configs.iter().enumerate() {
+            if self.remote.as_ref().is_some_and(|r| r.places(c.id)) {
+                continue;
+            }
             let file = (self.ports.dir()).join(crate::results::layout::node_config_file(c.id));
             c.write(&file).map_err(|e| ProcessError::Io {
                 path: file.clone(),
                 source: std::io::Error::other(e),
             })?;
-            let file = file.to_string_lossy().into_owned();
-            let mut env = vec![("ATTSYNC_CONFIG".to_string(), file.clone())];
-            let config_arg = ["--config".to_string(), file];
             let log = self.log_of(i);
-            let spawned = match plugin_of(self.net, &self.opts.plugins, i) {
-                Some(p) => {
-                    env.extend(p.env.iter().map(|(k, v)| (k.clone(), v.clone())));
-                    let args: Vec<String> =
-                        p.command[1..].iter().cloned().chain(config_arg).collect();
-                    let program = Path::new(&p.command[0]);
-                    self.sup.spawn(i, program, &args, &env, Some(&p.dir), &log)
-                }
-                None => {
-                    let bin = if i == 0 { &leader_bin } else { &agent_bin };
-                    self.sup.spawn(i, bin, &config_arg, &env, None, &log)
-                }
+            let launch = match plugin_of(self.net, &self.opts.plugins, i) {
+                Some(p) => Launch::Plugin {
+                    command: &p.command,
+                    env: &p.env,
+                    dir: &p.dir,
+                },
+                None => Launch::Builtin(if i == 0 { &leader_bin } else { &agent_bin }),
             };
-            spawned.map_err(io_at(&log))?;
+            (self.sup)
+                .spawn_node(i, &launch, &file, &log)
+                .map_err(io_at(&log))?;
         }
         Ok(())
     }
@@ -149,20 +154,56 @@ impl<'a> Session<'a> {
         }
     }
 
-    /// Sends `Start` (in real-time mode: for a moment just ahead).
+    /// Sends `Start` (in real-time mode: for a moment just ahead), here
+    /// and to every host.
     pub(super) fn start(&mut self) -> Result<(), Failure> {
-        let at = self
-            .opts
-            .realtime
-            .map(|_| msgs::unix_ns_now() + REALTIME_LEAD.as_nanos() as u64);
-        self.ports
-            .start(at)
+        let msg = match self.opts.realtime {
+            Some(_) => ControlMsg::start_at(msgs::unix_ns_now() + REALTIME_LEAD.as_nanos() as u64),
+            None => ControlMsg::new(ControlCommand::Start),
+        };
+        if let Some(r) = &self.remote {
+            r.control(msg)?;
+        }
+        (self.ports)
+            .send(msg)
             .map_err(|_| "cannot send Start".to_string())
+    }
+
+    /// Hands each host its nodes and starts the bridges of a run placed
+    /// over hosts (nothing otherwise).
+    pub(super) fn start_remote(&mut self) -> Result<(), Failure> {
+        let Some(remote) = self.remote.as_mut() else {
+            return Ok(());
+        };
+        let configs = node_configs(self.net, self.ports.run(), self.ports.dir(), self.opts);
+        let ns = crate::remote::local::LocalNs {
+            run: self.ports.run().to_string(),
+            dir: self.ports.dir().to_owned(),
+            limits: Limits::of(self.net),
+            stage_timeout: Duration::from_secs_f64(self.opts.stage_timeout),
+        };
+        let (net, opts) = (self.net, self.opts);
+        let node = |id: u32| {
+            let i = (0..=net.agents.len())
+                .find(|&i| node_id(net, i) == id)
+                .unwrap_or(0);
+            let plugin =
+                plugin_of(net, &opts.plugins, i).map(|p| crate::remote::wire::PluginCommand {
+                    command: p.command.clone(),
+                    env: p.env.clone(),
+                    dir: p.dir.clone(),
+                });
+            (node_name(net, i), plugin)
+        };
+        remote.start(&ns, &configs, &node)
     }
 
     /// Fails if a node has ended before it was done, or on an interrupt.
     pub(super) fn still_running(&mut self) -> Result<(), Failure> {
         if let Some(f) = self.ended_early() {
+            return Err(f);
+        }
+        if let Some(f) = self.remote_ended_early()? {
             return Err(f);
         }
         if self.interrupt.load(Ordering::Relaxed) {

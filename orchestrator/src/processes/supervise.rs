@@ -177,6 +177,33 @@ impl Supervisor {
         Ok(pid)
     }
 
+    /// Starts node `index` as `launch` says, with its configuration file
+    /// `config` (`--config FILE` appended, `ATTSYNC_CONFIG` set), output
+    /// into `log`: the rules of every run, local or on a host.
+    pub fn spawn_node(
+        &mut self,
+        index: usize,
+        launch: &Launch<'_>,
+        config: &Path,
+        log: &Path,
+    ) -> std::io::Result<Option<u32>> {
+        let file = config.to_string_lossy().into_owned();
+        let mut env = vec![("ATTSYNC_CONFIG".to_string(), file.clone())];
+        let config_arg = ["--config".to_string(), file];
+        match launch {
+            Launch::Plugin {
+                command,
+                env: extra,
+                dir,
+            } => {
+                env.extend(extra.iter().map(|(k, v)| (k.clone(), v.clone())));
+                let args: Vec<String> = command[1..].iter().cloned().chain(config_arg).collect();
+                self.spawn(index, Path::new(&command[0]), &args, &env, Some(dir), log)
+            }
+            Launch::Builtin(bin) => self.spawn(index, bin, &config_arg, &env, None, log),
+        }
+    }
+
     /// An exit that happened since the last call, if any.
     pub fn try_exit(&mut self) -> Option<Exit> {
         let e = self.exits.try_recv().ok()?;
@@ -234,6 +261,22 @@ impl Drop for Supervisor {
             let _ = self.wait_all(Duration::from_secs(5));
         }
     }
+}
+
+/// What runs a node: a plug-in's command in its directory, or a built-in binary.
+#[derive(Debug, Clone, Copy)]
+pub enum Launch<'a> {
+    /// `command[0] command[1..]… --config FILE`, in `dir`, with `env` added.
+    Plugin {
+        /// Program and arguments.
+        command: &'a [String],
+        /// Extra environment variables.
+        env: &'a std::collections::BTreeMap<String, String>,
+        /// Working directory.
+        dir: &'a Path,
+    },
+    /// `attsync-agent` or `attsync-leader`.
+    Builtin(&'a Path),
 }
 
 /// SIGKILL to the process group led by `pgid` (each node leads its own).

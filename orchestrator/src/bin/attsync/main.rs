@@ -35,11 +35,13 @@ fn main() -> ExitCode {
     }
 }
 
-/// Logs to stderr at the level of `ATTSYNC_LOG` (default `warn`; `debug`
-/// shows the phases of a run), as ARCHITECTURE.md's logging policy says.
+/// Logs to stderr at the level of `ATTSYNC_LOG` (default `warn`, Zenoh's
+/// own `error`: its warnings are about its configuration, which attsync
+/// sets; `debug` shows the phases of a run), as ARCHITECTURE.md's logging
+/// policy says.
 fn init_tracing() {
     let filter = tracing_subscriber::EnvFilter::try_from_env("ATTSYNC_LOG")
-        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn"));
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn,zenoh=error"));
     tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)

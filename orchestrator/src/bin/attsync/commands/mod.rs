@@ -5,6 +5,7 @@ mod check;
 mod conform;
 mod export;
 mod r#gen;
+mod host;
 mod mc;
 mod run;
 mod sweep;
@@ -52,6 +53,10 @@ pub enum Command {
     /// differing sample: time, node, field, both values). Exit code 0 only if
     /// bit-identical, 1 if not, 2 if the run cannot be verified.
     Verify(verify::Verify),
+    /// The daemon of one machine of a run across hosts: it accepts runs from
+    /// `attsync run --hosts`, starts the nodes placed on it, carries the cut
+    /// edges over Zenoh, and cleans up after each run. Runs until SIGTERM.
+    Host(host::Host),
 }
 
 /// Runs `command`.
@@ -66,6 +71,7 @@ pub fn exec(command: Command) -> Result<(), Error> {
         Command::Mc(a) => mc::exec(a, &interrupt()?),
         Command::View(a) => view::exec(a),
         Command::Verify(a) => verify::exec(a, &interrupt()?),
+        Command::Host(a) => host::exec(a, &interrupt()?),
     }
 }
 

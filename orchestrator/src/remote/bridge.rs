@@ -1,0 +1,253 @@
+//! The bridge of a run's cut edges on one side: for each local sender with
+//! receivers elsewhere, a thread that reads its iceoryx2 state service and
+//! puts every message on a [`LinkSender`]; for each remote sender with
+//! receivers here, a thread that takes its messages off a [`LinkReceiver`]
+//! and publishes them into a local state service for that sender, with
+//! attsync's own service settings (`msgs::open::state`), waking the
+//! receivers. The receiving node sees a normal local input. The exact
+//! bytes travel, in order, losslessly: lockstep stays byte-identical.
+
+use super::Side;
+use super::keys;
+use super::link::{LinkReceiver, LinkSender, STATE_WINDOW};
+use super::local::{LocalNs, Shared};
+use super::wire::StateLink;
+use iceoryx2::prelude::*;
+use msgs::StateMsg;
+use msgs::bytes::Bytes;
+use msgs::iox::iox;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// How long a bridge thread sleeps on its wake event or queue before it
+/// looks at the stop flag again.
+const SLICE: Duration = Duration::from_millis(1);
+
+/// The running bridge threads of one side; stopped and joined on drop.
+pub struct Bridges {
+    shared: Shared,
+    threads: Vec<JoinHandle<()>>,
+}
+
+impl Bridges {
+    /// Starts the threads of `links` on side `me`: one that sends every
+    /// link leaving `me`, one per link reaching `me`.
+    #[must_use]
+    pub fn start(
+        session: &zenoh::Session,
+        ns: &LocalNs,
+        run: &str,
+        me: &Side,
+        links: &[StateLink],
+        shared: &Shared,
+    ) -> Self {
+        let mut threads = Vec::new();
+        let out: Vec<StateLink> = links
+            .iter()
+            .filter(|l| l.from_side == *me)
+            .cloned()
+            .collect();
+        if !out.is_empty() {
+            let (s, ns, run, sh) = (session.clone(), ns.clone(), run.to_string(), shared.clone());
+            threads.push(std::thread::spawn(move || {
+                if let Err(e) = send_states(&s, &ns, &run, &out, &sh) {
+                    sh.fail(format!(
+                        "bridge of the states leaving {}: {e}",
+                        out[0].from_side
+                    ));
+                }
+            }));
+        }
+        for l in links.iter().filter(|l| l.to_side == *me) {
+            let (s, ns, key) = (
+                session.clone(),
+                ns.clone(),
+                keys::state_link(run, l.from, &l.to_side),
+            );
+            let (l, sh) = (l.clone(), shared.clone());
+            threads.push(std::thread::spawn(move || {
+                if let Err(e) = receive_states(&s, &ns, &key, &l, &sh) {
+                    sh.fail(format!(
+                        "bridge of node {}'s states to {}: {e}",
+                        l.from, l.to_side
+                    ));
+                }
+            }));
+        }
+        Self {
+            shared: shared.clone(),
+            threads,
+        }
+    }
+}
+
+impl Drop for Bridges {
+    fn drop(&mut self) {
+        self.shared.stop();
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+    }
+}
+
+/// One link's sending end: a subscriber per receiver over there (the
+/// sender counts its receivers before it is ready), the first forwarded,
+/// the others drained.
+struct Outgoing {
+    subs: Vec<iceoryx2::port::subscriber::Subscriber<ipc::Service, StateMsg, ()>>,
+    link: LinkSender,
+}
+
+impl Outgoing {
+    /// Forwards what the window allows; whether anything moved.
+    fn pump(&mut self) -> Result<bool, String> {
+        let mut moved = false;
+        for s in &self.subs[1..] {
+            while s.receive().map_err(|e| format!("{e:?}"))?.is_some() {}
+        }
+        while self.link.has_credit() {
+            let Some(m) = self.subs[0].receive().map_err(|e| format!("{e:?}"))? else {
+                break;
+            };
+            let bytes = m.to_bytes();
+            drop(m);
+            self.link.send_now(bytes).map_err(|e| e.to_string())?;
+            moved = true;
+        }
+        Ok(moved)
+    }
+}
+
+/// The sending side of every link leaving this side, on one thread that
+/// sleeps on the wake events of the receivers over there (nobody else
+/// listens to them on this side). A link without credit leaves its
+/// messages in iceoryx2 (holding its sender back) and never blocks another.
+fn send_states(
+    session: &zenoh::Session,
+    ns: &LocalNs,
+    run: &str,
+    links: &[StateLink],
+    sh: &Shared,
+) -> Result<(), String> {
+    let node = ns.node("bridge-out").map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    for l in links {
+        let svc =
+            msgs::open::state(&node, &ns.run, l.from, &ns.limits).map_err(|e| e.to_string())?;
+        let subs = (l.receivers.iter())
+            .map(|_| {
+                svc.subscriber_builder()
+                    .buffer_size(ns.limits.state_buffer)
+                    .create()
+                    .map_err(|e| iox("bridge state subscriber")(e).to_string())
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let key = keys::state_link(run, l.from, &l.to_side);
+        let link = LinkSender::open(session, &key, STATE_WINDOW).map_err(|e| e.to_string())?;
+        out.push(Outgoing { subs, link });
+    }
+    let mut remote: Vec<u32> = links
+        .iter()
+        .flat_map(|l| l.receivers.iter().copied())
+        .collect();
+    remote.sort_unstable();
+    remote.dedup();
+    let listeners = (remote.iter())
+        .map(|&r| {
+            msgs::open::wake(&node, &ns.run, r, &ns.limits)
+                .map_err(|e| e.to_string())?
+                .listener_builder()
+                .create()
+                .map_err(|e| iox("bridge wake listener")(e).to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let waitset = WaitSetBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| format!("iceoryx2 waitset: {e:?}"))?;
+    let _guards = (listeners.iter())
+        .map(|l| waitset.attach_notification(l))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("iceoryx2 waitset: {e:?}"))?;
+    while !sh.stopping() {
+        let _ =
+            waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, SLICE);
+        for l in &listeners {
+            let _ = l.try_wait(|_| {});
+        }
+        let mut moved = true;
+        while moved {
+            moved = false;
+            for o in &mut out {
+                moved |= o.pump()?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The receiving side of `l`: the sender's only publisher on this side,
+/// holding back (like a node's own publisher) while a receiver's buffer is
+/// full, at most the stage timeout.
+fn receive_states(
+    session: &zenoh::Session,
+    ns: &LocalNs,
+    key: &str,
+    l: &StateLink,
+    sh: &Shared,
+) -> Result<(), String> {
+    let node = ns
+        .node(&format!("bridge-in-{}", l.from))
+        .map_err(|e| e.to_string())?;
+    let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits).map_err(|e| e.to_string())?;
+    let publisher = svc
+        .publisher_builder()
+        .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+        .set_backpressure_handler(hold_back(ns.stage_timeout, sh.clone()))
+        .create()
+        .map_err(|e| iox("bridge state publisher")(e).to_string())?;
+    let notifiers = (l.receivers.iter())
+        .map(|&r| {
+            msgs::open::wake(&node, &ns.run, r, &ns.limits)
+                .map_err(|e| e.to_string())?
+                .notifier_builder()
+                .create()
+                .map_err(|e| iox("bridge wake notifier")(e).to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut link = LinkReceiver::open(session, key, STATE_WINDOW).map_err(|e| e.to_string())?;
+    while !sh.stopping() {
+        let Some(bytes) = link.recv(SLICE * 20).map_err(|e| e.to_string())? else {
+            continue;
+        };
+        let m = StateMsg::from_bytes(&bytes).map_err(|e| e.to_string())?;
+        if sh.stopping() {
+            break;
+        }
+        publisher
+            .send_copy(m)
+            .map_err(|e| iox("bridge state send")(e).to_string())?;
+        for n in &notifiers {
+            let _ = n.notify();
+        }
+        link.delivered().map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// A backpressure handler: retry every 50 µs, give up after `timeout` or
+/// when the run stops.
+fn hold_back(
+    timeout: Duration,
+    sh: Shared,
+) -> impl Fn(&iceoryx2::port::BackpressureInfo) -> iceoryx2::port::BackpressureAction + Send + 'static
+{
+    move |info| {
+        if info.elapsed_time > timeout || sh.stopping() {
+            iceoryx2::port::BackpressureAction::DiscardDataAndFail
+        } else {
+            std::thread::sleep(Duration::from_micros(50));
+            iceoryx2::port::BackpressureAction::Retry
+        }
+    }
+}

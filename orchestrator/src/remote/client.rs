@@ -1,0 +1,370 @@
+//! The orchestrator's side of a run placed over hosts ([`Remote`]): one
+//! Zenoh session dialling every host, a liveliness token for the run, a
+//! watch on the hosts' tokens, the run handed to each host, the bridges of
+//! the cut edges touching local nodes, one telemetry sink per host, `Start`
+//! and `Stop` relayed, each host's node exits and failures as they happen,
+//! and at the end every host's exits and logs.
+
+use super::Side;
+use super::bridge::Bridges;
+use super::keys;
+use super::local::{LocalNs, Shared};
+use super::plan::{Plan, links};
+use super::telemetry::{self, End, TelemetryThread};
+use super::wire::{Answer, EndReply, EndRequest, HostEvent, RemoteNode, RunRequest};
+use super::zconfig;
+use msgs::ControlMsg;
+use msgs::bytes::Bytes;
+use msgs::config::NodeConfig;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use zenoh::Wait;
+use zenoh::handlers::{FifoChannel, FifoChannelHandler};
+use zenoh::pubsub::Subscriber;
+use zenoh::query::ConsolidationMode;
+use zenoh::sample::Sample;
+
+/// How long a host may take to answer its first ping (its daemon starting,
+/// the connection being dialled).
+pub const REACH_TIMEOUT: Duration = Duration::from_secs(5);
+/// Longest wait for a host to start its nodes, or to end them.
+const ANSWER_TIMEOUT: Duration = Duration::from_secs(30);
+
+/// A node's exit on a host, as the host reported it.
+#[derive(Debug, Clone)]
+pub struct RemoteExit {
+    /// The node's id.
+    pub id: u32,
+    /// The host's name.
+    pub host: String,
+    /// Its exit, described.
+    pub status: String,
+    /// It exited with code 0.
+    pub clean: bool,
+    /// The last lines of its log.
+    pub tail: String,
+}
+
+/// The orchestrator's connection to the hosts of one run. Dropping it stops
+/// the bridges, then withdraws the run's token (the hosts clean up).
+pub struct Remote {
+    sinks: Vec<TelemetryThread>,
+    bridges: Option<Bridges>,
+    shared: Shared,
+    events: Subscriber<FifoChannelHandler<Sample>>,
+    lost: Arc<Mutex<Vec<String>>>,
+    _watch: Subscriber<()>,
+    _token: zenoh::liveliness::LivelinessToken,
+    plan: Plan,
+    run: String,
+    /// Hosts that accepted the run (and must be asked to end it).
+    started: Vec<String>,
+    session: zenoh::Session,
+}
+
+impl std::fmt::Debug for Remote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Remote")
+            .field("run", &self.run)
+            .field("plan", &self.plan)
+            .finish_non_exhaustive()
+    }
+}
+
+fn zerr(e: impl std::fmt::Display) -> String {
+    format!("zenoh: {e}")
+}
+
+impl Remote {
+    /// Dials every host of `plan` for run `run` and waits until each answers
+    /// a ping (an error names the first host that does not).
+    pub fn connect(plan: &Plan, run: &str) -> Result<Self, String> {
+        let endpoints: Vec<String> = plan.hosts.iter().map(|h| h.endpoint.clone()).collect();
+        let session = zconfig::open(&[], &endpoints).map_err(|e| e.to_string())?;
+        let token = (session.liveliness())
+            .declare_token(keys::orchestrator_alive(run))
+            .wait()
+            .map_err(zerr)?;
+        let lost = Arc::new(Mutex::new(Vec::new()));
+        let l = lost.clone();
+        let watch = (session.liveliness())
+            .declare_subscriber(keys::ANY_HOST_ALIVE)
+            .callback(move |s: Sample| {
+                if s.kind() == zenoh::sample::SampleKind::Delete {
+                    let name = s
+                        .key_expr()
+                        .as_str()
+                        .split('/')
+                        .nth(2)
+                        .unwrap_or("")
+                        .to_string();
+                    if let Ok(mut v) = l.lock() {
+                        v.push(name);
+                    }
+                }
+            })
+            .wait()
+            .map_err(zerr)?;
+        let events = session
+            .declare_subscriber(keys::events(run, "*"))
+            .with(FifoChannel::new(1024))
+            .wait()
+            .map_err(zerr)?;
+        let remote = Self {
+            sinks: Vec::new(),
+            bridges: None,
+            shared: Shared::default(),
+            events,
+            lost,
+            _watch: watch,
+            _token: token,
+            plan: plan.clone(),
+            run: run.to_string(),
+            started: Vec::new(),
+            session,
+        };
+        for h in &plan.hosts {
+            remote.ping(&h.name, &h.endpoint)?;
+        }
+        Ok(remote)
+    }
+
+    /// Waits up to [`REACH_TIMEOUT`] for host `name`'s answer to a ping.
+    fn ping(&self, name: &str, endpoint: &str) -> Result<(), String> {
+        let until = Instant::now() + REACH_TIMEOUT;
+        while Instant::now() < until {
+            let replies = (self.session.get(keys::ping(name)))
+                .consolidation(ConsolidationMode::None)
+                .timeout(Duration::from_millis(500))
+                .wait()
+                .map_err(zerr)?;
+            if replies.recv().is_ok_and(|r| r.result().is_ok()) {
+                return Ok(());
+            }
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        Err(format!(
+            "host {name} ({endpoint}) is unreachable: no answer within {} s; is \
+             `attsync host --name {name} --listen {endpoint}` running there, and its port open?",
+            REACH_TIMEOUT.as_secs()
+        ))
+    }
+
+    /// Whether node `id` runs on a host.
+    #[must_use]
+    pub fn places(&self, id: u32) -> bool {
+        self.plan.side_of(id) != Side::Orchestrator
+    }
+
+    /// The host of node `id`, if it runs on one.
+    #[must_use]
+    pub fn host_of(&self, id: u32) -> Option<String> {
+        match self.plan.side_of(id) {
+            Side::Host(h) => Some(h),
+            Side::Orchestrator => None,
+        }
+    }
+
+    /// Starts the local bridges and telemetry sinks in `ns`, then hands each
+    /// host its nodes (`configs` of every node; `names`, `plugins` by node id).
+    pub fn start(
+        &mut self,
+        ns: &LocalNs,
+        configs: &[NodeConfig],
+        node: &dyn Fn(u32) -> (String, Option<super::wire::PluginCommand>),
+    ) -> Result<(), String> {
+        let links = links(configs, &self.plan);
+        let (s, run) = (&self.session, self.run.as_str());
+        self.bridges = Some(Bridges::start(
+            s,
+            ns,
+            run,
+            &Side::Orchestrator,
+            &links,
+            &self.shared,
+        ));
+        for h in &self.plan.hosts {
+            let ids = h.nodes.clone();
+            let sink = telemetry::start(End::Sink, s, ns, (run, &h.name), ids, &self.shared);
+            self.sinks.push(sink);
+        }
+        let mut pending = Vec::new();
+        for h in &self.plan.hosts {
+            let me = Side::Host(h.name.clone());
+            let req = RunRequest {
+                run: self.run.clone(),
+                host: h.name.clone(),
+                nodes: (configs.iter())
+                    .filter(|c| h.nodes.contains(&c.id))
+                    .map(|c| {
+                        let (name, plugin) = node(c.id);
+                        RemoteNode {
+                            name,
+                            config: c.clone(),
+                            plugin,
+                        }
+                    })
+                    .collect(),
+                links: (links.iter())
+                    .filter(|l| l.from_side == me || l.to_side == me)
+                    .cloned()
+                    .collect(),
+            };
+            let body = serde_json::to_vec(&req).expect("serialises");
+            let replies = (s.get(keys::run(&h.name)))
+                .payload(body)
+                .consolidation(ConsolidationMode::None)
+                .timeout(ANSWER_TIMEOUT)
+                .wait()
+                .map_err(zerr)?;
+            pending.push((h.name.clone(), replies));
+        }
+        for (name, replies) in pending {
+            let answer: Answer = match replies.recv() {
+                Ok(r) => match r.result() {
+                    Ok(s) => serde_json::from_slice(&s.payload().to_bytes())
+                        .unwrap_or_else(|e| Err(format!("a bad answer: {e}"))),
+                    Err(e) => Err(String::from_utf8_lossy(&e.payload().to_bytes()).into_owned()),
+                },
+                Err(_) => Err(format!("no answer within {} s", ANSWER_TIMEOUT.as_secs())),
+            };
+            answer.map_err(|e| format!("host {name} could not start its nodes: {e}"))?;
+            self.started.push(name);
+        }
+        Ok(())
+    }
+
+    /// Relays control message `m` to every host.
+    pub fn control(&self, m: ControlMsg) -> Result<(), String> {
+        (self.session.put(keys::control(&self.run), m.to_bytes()))
+            .congestion_control(zenoh::qos::CongestionControl::Block)
+            .express(true)
+            .wait()
+            .map_err(zerr)
+    }
+
+    /// A lost host, a host's failure, or a bridge's: the run cannot go on.
+    /// `Ok` carries the node exits the hosts reported since the last call.
+    pub fn check(&self) -> Result<Vec<RemoteExit>, String> {
+        if let Some(h) = self.lost_host() {
+            let nodes: Vec<String> = (self.plan.hosts.iter())
+                .find(|p| p.name == h)
+                .map(|p| p.nodes.iter().map(|&id| node_name(id)).collect())
+                .unwrap_or_default();
+            return Err(format!(
+                "host {h} was lost (its daemon or the connection to it is gone); its nodes: {}",
+                nodes.join(", ")
+            ));
+        }
+        if let Some(f) = self.shared.failure() {
+            return Err(f);
+        }
+        let mut exits = Vec::new();
+        while let Ok(Some(s)) = self.events.try_recv() {
+            let host = s
+                .key_expr()
+                .as_str()
+                .rsplit('/')
+                .next()
+                .unwrap_or("")
+                .to_string();
+            match serde_json::from_slice::<HostEvent>(&s.payload().to_bytes()) {
+                Ok(HostEvent::Exited {
+                    id,
+                    status,
+                    clean,
+                    tail,
+                }) => exits.push(RemoteExit {
+                    id,
+                    host,
+                    status,
+                    clean,
+                    tail,
+                }),
+                Ok(HostEvent::Failed(f)) => return Err(format!("host {host}: {f}")),
+                Err(e) => return Err(format!("host {host} sent a bad event: {e}")),
+            }
+        }
+        Ok(exits)
+    }
+
+    /// A host of the run whose liveliness token is gone.
+    fn lost_host(&self) -> Option<String> {
+        let lost = self.lost.lock().ok()?;
+        (lost.iter())
+            .find(|h| self.plan.hosts.iter().any(|p| &p.name == *h))
+            .cloned()
+    }
+
+    /// Ends the run on every host that started it (`kill`: at once), writes
+    /// each node's log into `logs`, and returns the exits that were not clean.
+    pub fn finish(&mut self, kill: bool, logs: &Path) -> Vec<RemoteExit> {
+        let mut bad = Vec::new();
+        let lost = self.lost_host();
+        let mut pending = Vec::new();
+        for name in std::mem::take(&mut self.started) {
+            if lost.as_deref() == Some(name.as_str()) {
+                continue;
+            }
+            let req = EndRequest {
+                run: self.run.clone(),
+                kill,
+            };
+            let got = (self.session.get(keys::end(&name)))
+                .payload(serde_json::to_vec(&req).expect("serialises"))
+                .consolidation(ConsolidationMode::None)
+                .timeout(ANSWER_TIMEOUT)
+                .wait();
+            if let Ok(r) = got {
+                pending.push((name, r));
+            }
+        }
+        for (name, replies) in pending {
+            let reply: Option<EndReply> = replies
+                .recv()
+                .ok()
+                .and_then(|r| r.result().ok().map(|s| s.payload().to_bytes().into_owned()))
+                .and_then(|b| serde_json::from_slice(&b).ok());
+            let Some(reply) = reply else {
+                bad.push(RemoteExit {
+                    id: u32::MAX,
+                    host: name.clone(),
+                    status: "did not report how its nodes ended".into(),
+                    clean: false,
+                    tail: String::new(),
+                });
+                continue;
+            };
+            for n in reply.nodes {
+                let file = logs.join(crate::results::layout::node_log_file(&node_name(n.id)));
+                let _ = std::fs::write(&file, &n.log);
+                if !n.clean {
+                    bad.push(RemoteExit {
+                        id: n.id,
+                        host: name.clone(),
+                        status: n.status,
+                        clean: false,
+                        tail: String::new(),
+                    });
+                }
+            }
+            for f in reply.leftovers {
+                tracing::warn!(host = %name, "left behind: {f}");
+            }
+        }
+        self.shared.stop();
+        self.sinks.clear();
+        self.bridges = None;
+        bad
+    }
+}
+
+/// `leader`, `agent-<id>`.
+fn node_name(id: u32) -> String {
+    if id == 0 {
+        "leader".into()
+    } else {
+        format!("agent-{id}")
+    }
+}

@@ -1,0 +1,262 @@
+//! One run on a host daemon, on a thread of its own: a fresh local
+//! iceoryx2 namespace, the nodes placed here started with the rules of a
+//! local run, the run's bridges (its cut edges, its telemetry), `Start` and
+//! `Stop` relayed into the namespace, exits reported at once; at the end
+//! (the orchestrator asks, its liveliness token is gone, or the daemon
+//! stops) every node is killed or waited for and everything is removed.
+
+use super::Side;
+use super::bridge::Bridges;
+use super::keys;
+use super::local::{LocalNs, Shared};
+use super::telemetry::{self, End, TelemetryThread};
+use super::wire::{EndReply, EndRequest, HostEvent, NodeEnd, RunRequest};
+use crate::processes::namespace::Namespace;
+use crate::processes::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
+use iceoryx2::prelude::*;
+use msgs::ControlMsg;
+use msgs::bytes::Bytes;
+use msgs::config::Contention;
+use msgs::iox::iox;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::Receiver;
+use std::time::{Duration, Instant};
+use zenoh::Wait;
+use zenoh::query::Query;
+
+/// What the daemon tells a run's thread.
+pub enum Command {
+    /// The orchestrator ends the run; reply to the query.
+    End(EndRequest, Query),
+    /// The daemon stops: kill everything.
+    Abort,
+}
+
+/// Longest wait for the nodes to exit after `Stop`.
+const STOP_TIMEOUT: Duration = Duration::from_secs(10);
+/// Longest wait for killed nodes to be gone.
+const KILL_TIMEOUT: Duration = Duration::from_secs(5);
+/// How long the run's orchestrator may take to show its liveliness token.
+const ORCHESTRATOR_GRACE: Duration = Duration::from_secs(5);
+/// The run thread's poll period.
+const TICK: Duration = Duration::from_millis(5);
+
+/// A run's resources, dropped in this order: bridges, ports, processes, namespace.
+struct Resources {
+    _telemetry: TelemetryThread,
+    _bridges: Bridges,
+    control: iceoryx2::port::publisher::Publisher<ipc::Service, ControlMsg, ()>,
+    _node: iceoryx2::node::Node<ipc::Service>,
+    sup: Supervisor,
+    ns: Namespace,
+}
+
+/// The nodes of a run here: (id, name, log file).
+type Nodes = Vec<(u32, String, PathBuf)>;
+
+/// Starts `req`'s nodes and bridges; an error says why, for the orchestrator.
+fn start(
+    session: &zenoh::Session,
+    req: &RunRequest,
+    shared: &Shared,
+) -> Result<(Resources, Nodes), String> {
+    let (agent_bin, leader_bin) = find_binaries()?;
+    let ns = Namespace::create().map_err(|e| format!("namespace: {e}"))?;
+    let logs = ns.dir().join("logs");
+    std::fs::create_dir_all(&logs).map_err(|e| format!("{}: {e}", logs.display()))?;
+    let first = req.nodes.first().ok_or("a run without nodes")?;
+    let local = LocalNs {
+        run: ns.run().to_string(),
+        dir: ns.dir().to_owned(),
+        limits: first.config.limits,
+        stage_timeout: Duration::from_secs_f64(first.config.stage_timeout),
+    };
+    let node = local.node("host").map_err(|e| e.to_string())?;
+    let control = msgs::open::control(&node, &local.run, &local.limits)
+        .map_err(|e| e.to_string())?
+        .publisher_builder()
+        .create()
+        .map_err(|e| iox("control publisher")(e).to_string())?;
+    let me = Side::Host(req.host.clone());
+    let bridges = Bridges::start(session, &local, &req.run, &me, &req.links, shared);
+    let ids = req.nodes.iter().map(|n| n.config.id).collect();
+    let telemetry = telemetry::start(
+        End::Forward,
+        session,
+        &local,
+        (&req.run, &req.host),
+        ids,
+        shared,
+    );
+    let mut sup = Supervisor::new().map_err(|e| format!("tokio runtime: {e}"))?;
+    let mut nodes = Vec::new();
+    for (i, n) in req.nodes.iter().enumerate() {
+        let mut c = n.config.clone();
+        c.run.clone_from(&local.run);
+        c.iox_root = local.dir.to_string_lossy().into_owned();
+        c.contention = Contention::Waiter; // no placer watches this machine
+        let file = local
+            .dir
+            .join(crate::results::layout::node_config_file(c.id));
+        c.write(&file)
+            .map_err(|e| format!("{}: {e}", file.display()))?;
+        let log = logs.join(crate::results::layout::node_log_file(&n.name));
+        let launch = match &n.plugin {
+            Some(p) => Launch::Plugin {
+                command: &p.command,
+                env: &p.env,
+                dir: &p.dir,
+            },
+            None => Launch::Builtin(if c.id == 0 { &leader_bin } else { &agent_bin }),
+        };
+        sup.spawn_node(i, &launch, &file, &log)
+            .map_err(|e| format!("{}: {e}", log.display()))?;
+        nodes.push((c.id, n.name.clone(), log));
+    }
+    let r = Resources {
+        _telemetry: telemetry,
+        _bridges: bridges,
+        control,
+        _node: node,
+        sup,
+        ns,
+    };
+    Ok((r, nodes))
+}
+
+/// Serves run `req` until it ends; `reply` gets the answer to the run request.
+pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: Receiver<Command>) {
+    let shared = Shared::default();
+    // Declared before the answer, so that no command of the run is missed.
+    let control = session.declare_subscriber(keys::control(&req.run)).wait();
+    let events = session
+        .declare_publisher(keys::events(&req.run, &req.host))
+        .wait();
+    let (alive, lost) = (
+        Arc::new(AtomicBool::new(false)),
+        Arc::new(AtomicBool::new(false)),
+    );
+    let (a, l) = (alive.clone(), lost.clone());
+    let watch = session
+        .liveliness()
+        .declare_subscriber(keys::orchestrator_alive(&req.run))
+        .history(true)
+        .callback(move |s| match s.kind() {
+            zenoh::sample::SampleKind::Put => a.store(true, Ordering::Relaxed),
+            zenoh::sample::SampleKind::Delete => l.store(true, Ordering::Relaxed),
+        })
+        .wait();
+    let (Ok(control), Ok(events), Ok(_watch)) = (control, events, watch) else {
+        answer(
+            &reply,
+            &Err("zenoh: cannot declare the run's subscribers".into()),
+        );
+        return;
+    };
+    let (mut res, nodes) = match start(&session, &req, &shared) {
+        Ok(x) => x,
+        Err(e) => {
+            tracing::warn!(run = %req.run, "cannot start the run: {e}");
+            answer(&reply, &Err(e));
+            return;
+        }
+    };
+    answer(&reply, &Ok(()));
+    drop(reply); // its final reply: the orchestrator's query completes
+    tracing::info!(run = %req.run, nodes = nodes.len(), "run started");
+    let began = Instant::now();
+    let mut exits: Vec<Option<Exit>> = (0..nodes.len()).map(|_| None).collect();
+    let mut failed_said = false;
+    let put = |e: &HostEvent| {
+        let _ = events
+            .put(serde_json::to_vec(e).expect("serialises"))
+            .wait();
+    };
+    let end = loop {
+        while let Some(e) = res.sup.try_exit() {
+            let (id, _, log) = &nodes[e.index];
+            put(&HostEvent::Exited {
+                id: *id,
+                status: describe(&e.status),
+                clean: matches!(&e.status, Ok(s) if s.success()),
+                tail: tail(log, 10),
+            });
+            let k = e.index;
+            exits[k] = Some(e);
+        }
+        while let Ok(Some(s)) = control.try_recv() {
+            if let Ok(m) = ControlMsg::from_bytes(&s.payload().to_bytes()) {
+                let _ = res.control.send_copy(m);
+            }
+        }
+        if let (Some(f), false) = (shared.failure(), failed_said) {
+            failed_said = true;
+            put(&HostEvent::Failed(f));
+        }
+        let gone = lost.load(Ordering::Relaxed)
+            || (!alive.load(Ordering::Relaxed) && began.elapsed() > ORCHESTRATOR_GRACE);
+        if gone {
+            tracing::warn!(run = %req.run, "the orchestrator is gone: cleaning the run up");
+            break None;
+        }
+        match commands.recv_timeout(TICK) {
+            Ok(Command::End(e, q)) => break Some((e, q)),
+            Ok(Command::Abort) | Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                break None;
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+        }
+    };
+    let kill = end.as_ref().is_none_or(|(e, _)| e.kill);
+    if kill {
+        res.sup.kill_all();
+    }
+    let timeout = if kill { KILL_TIMEOUT } else { STOP_TIMEOUT };
+    for e in res.sup.wait_all(timeout) {
+        let k = e.index;
+        exits[k] = Some(e);
+    }
+    let logs: Vec<Vec<u8>> = nodes
+        .iter()
+        .map(|(_, _, log)| std::fs::read(log).unwrap_or_default())
+        .collect();
+    let local_run = res.ns.run().to_string();
+    drop(res);
+    let leftovers = Namespace::leftovers(&local_run)
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    tracing::info!(run = %req.run, "run ended, namespace removed");
+    let Some((_, q)) = end else { return };
+    let reply = EndReply {
+        nodes: (nodes.iter().zip(exits).zip(logs))
+            .map(|(((id, _, _), e), log)| NodeEnd {
+                id: *id,
+                status: e
+                    .as_ref()
+                    .map_or("still running".into(), |e| describe(&e.status)),
+                clean: e.is_some_and(|e| matches!(&e.status, Ok(s) if s.success())),
+                log,
+            })
+            .collect(),
+        leftovers,
+    };
+    let _ = q
+        .reply(
+            q.key_expr().clone(),
+            serde_json::to_vec(&reply).expect("serialises"),
+        )
+        .wait();
+}
+
+/// Replies `a` to query `q`.
+pub fn answer(q: &Query, a: &super::wire::Answer) {
+    let _ = q
+        .reply(
+            q.key_expr().clone(),
+            serde_json::to_vec(a).expect("serialises"),
+        )
+        .wait();
+}

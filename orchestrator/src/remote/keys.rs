@@ -1,0 +1,73 @@
+//! Every Zenoh key expression attsync uses across hosts, in one place
+//! (PROTOCOL.md, "Across hosts"). `<run>` is the orchestrator's run id; a
+//! side is `orchestrator` or `host-<name>`.
+
+use super::Side;
+
+/// `attsync/host/<name>/<what>`: a daemon's queryables and its liveliness token.
+fn host(name: &str, what: &str) -> String {
+    format!("attsync/host/{name}/{what}")
+}
+
+/// A daemon's ping queryable: replies with its name and version.
+#[must_use]
+pub fn ping(name: &str) -> String {
+    host(name, "ping")
+}
+
+/// A daemon's queryable that accepts a run ([`super::wire::RunRequest`]).
+#[must_use]
+pub fn run(name: &str) -> String {
+    host(name, "run")
+}
+
+/// A daemon's queryable that ends a run ([`super::wire::EndRequest`]).
+#[must_use]
+pub fn end(name: &str) -> String {
+    host(name, "end")
+}
+
+/// A daemon's liveliness token (gone: the daemon or its connection is lost).
+#[must_use]
+pub fn host_alive(name: &str) -> String {
+    host(name, "alive")
+}
+
+/// Every daemon's liveliness token.
+pub const ANY_HOST_ALIVE: &str = "attsync/host/*/alive";
+
+/// The orchestrator's liveliness token of a run (gone: the daemons clean the run up).
+#[must_use]
+pub fn orchestrator_alive(run: &str) -> String {
+    format!("attsync/{run}/orchestrator/alive")
+}
+
+/// The run's control commands (`ControlMsg` bytes), orchestrator → daemons.
+#[must_use]
+pub fn control(run: &str) -> String {
+    format!("attsync/{run}/control")
+}
+
+/// A daemon's events of a run ([`super::wire::HostEvent`] JSON), daemon → orchestrator.
+#[must_use]
+pub fn events(run: &str, host: &str) -> String {
+    format!("attsync/{run}/events/{host}")
+}
+
+/// Node `from`'s states towards side `to` (`StateMsg` bytes); acks at `<key>/ack`.
+#[must_use]
+pub fn state_link(run: &str, from: u32, to: &Side) -> String {
+    format!("attsync/{run}/state/{from}/{}", to.key())
+}
+
+/// A host's telemetry (service id + `TelemetryMsg` bytes), daemon → orchestrator.
+#[must_use]
+pub fn telemetry_link(run: &str, host: &str) -> String {
+    format!("attsync/{run}/telemetry/{host}")
+}
+
+/// The acknowledgements of the link at `data`.
+#[must_use]
+pub fn ack(data: &str) -> String {
+    format!("{data}/ack")
+}

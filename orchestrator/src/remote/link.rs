@@ -1,0 +1,231 @@
+//! A lossless, ordered, bounded byte stream between two Zenoh sessions: data
+//! on a key, cumulative acknowledgements on `<key>/ack`. Zenoh carries the
+//! data reliably and in order (TCP, congestion control `Block`); the credit
+//! window bounds what is in flight, so a fast sender (the leader) is held
+//! back across hosts as iceoryx2's subscriber buffer holds it on one, and
+//! the receiver's queue never fills (a full queue would stall its session).
+//!
+//! Every message goes out at once (`express`: not held back to be batched;
+//! lockstep waits for each one, so its latency is the run's pace).
+//!
+//! Readiness: the receiver declares its subscriber, then acknowledges
+//! (count 0) every [`HELLO_EVERY`] until data flows; the sender sends nothing
+//! before its first acknowledgement, so no message is put before the other
+//! end listens.
+
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+use zenoh::Wait;
+use zenoh::handlers::{FifoChannel, FifoChannelHandler};
+use zenoh::pubsub::{Publisher, Subscriber};
+use zenoh::qos::CongestionControl;
+use zenoh::sample::Sample;
+
+/// How often an idle receiver repeats its acknowledgement (the hello).
+pub const HELLO_EVERY: Duration = Duration::from_millis(100);
+
+/// A link's window: at most `window` messages unacknowledged, acknowledged
+/// every `ack_every`.
+#[derive(Debug, Clone, Copy)]
+pub struct Window {
+    /// Messages in flight at most.
+    pub window: u64,
+    /// The receiver acknowledges after this many.
+    pub ack_every: u64,
+}
+
+/// State links: as deep as a state subscriber's buffer (`msgs::Limits::state_buffer`).
+pub const STATE_WINDOW: Window = Window {
+    window: 64,
+    ack_every: 16,
+};
+
+/// Telemetry links: as deep as the orchestrator's telemetry buffer.
+pub const TELEMETRY_WINDOW: Window = Window {
+    window: 256,
+    ack_every: 64,
+};
+
+/// A link failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum LinkError {
+    /// Zenoh refused a call.
+    #[error("zenoh: {0}")]
+    Zenoh(String),
+    /// No credit came back in time: the other end is gone or stalled.
+    #[error("no acknowledgement for {0:.1} s")]
+    Stalled(f64),
+    /// The run is ending.
+    #[error("stopped")]
+    Stopped,
+}
+
+fn zerr(e: impl std::fmt::Display) -> LinkError {
+    LinkError::Zenoh(e.to_string())
+}
+
+/// Acknowledged count (`None` before the hello), shared with the ack callback.
+type Acked = Arc<(Mutex<Option<u64>>, Condvar)>;
+
+/// The sending end.
+pub struct LinkSender {
+    publisher: Publisher<'static>,
+    acked: Acked,
+    _acks: Subscriber<()>,
+    sent: u64,
+    window: Window,
+}
+
+impl LinkSender {
+    /// Declares the publisher of `key` and the subscriber of its acks.
+    pub fn open(session: &zenoh::Session, key: &str, window: Window) -> Result<Self, LinkError> {
+        let publisher = session
+            .declare_publisher(key.to_string())
+            .congestion_control(CongestionControl::Block)
+            .express(true)
+            .wait()
+            .map_err(zerr)?;
+        let acked: Acked = Arc::new((Mutex::new(None), Condvar::new()));
+        let a = acked.clone();
+        let acks = session
+            .declare_subscriber(super::keys::ack(key))
+            .callback(move |s: Sample| {
+                let Ok(b) = <[u8; 8]>::try_from(s.payload().to_bytes().as_ref()) else {
+                    return;
+                };
+                let n = u64::from_le_bytes(b);
+                let (m, cv) = &*a;
+                let mut g = m.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+                *g = Some(g.map_or(n, |old| old.max(n)));
+                cv.notify_all();
+            })
+            .wait()
+            .map_err(zerr)?;
+        Ok(Self {
+            publisher,
+            acked,
+            _acks: acks,
+            sent: 0,
+            window,
+        })
+    }
+
+    /// Whether the receiver has said hello.
+    #[must_use]
+    pub fn connected(&self) -> bool {
+        self.acked.0.lock().is_ok_and(|g| g.is_some())
+    }
+
+    /// Whether a message may be sent now: the receiver said hello and the
+    /// window has room.
+    #[must_use]
+    pub fn has_credit(&self) -> bool {
+        let g = self
+            .acked
+            .0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        g.is_some_and(|a| self.sent - a < self.window.window)
+    }
+
+    /// Sends `bytes` now (call after [`Self::has_credit`]).
+    pub fn send_now(&mut self, bytes: Vec<u8>) -> Result<(), LinkError> {
+        self.publisher.put(bytes).wait().map_err(zerr)?;
+        self.sent += 1;
+        Ok(())
+    }
+
+    /// Sends `bytes` once the window has room; waits at most `timeout`,
+    /// giving up early when `stop()` says so.
+    pub fn send(
+        &mut self,
+        bytes: Vec<u8>,
+        timeout: Duration,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<(), LinkError> {
+        let deadline = Instant::now() + timeout;
+        let (m, cv) = &*self.acked;
+        let mut g = m.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        while g.is_none_or(|a| self.sent - a >= self.window.window) {
+            if stop() {
+                return Err(LinkError::Stopped);
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return Err(LinkError::Stalled(timeout.as_secs_f64()));
+            }
+            let slice = left.min(Duration::from_millis(20));
+            g = cv
+                .wait_timeout(g, slice)
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .0;
+        }
+        drop(g);
+        self.send_now(bytes)
+    }
+}
+
+/// The receiving end.
+pub struct LinkReceiver {
+    data: Subscriber<FifoChannelHandler<Sample>>,
+    acks: Publisher<'static>,
+    delivered: u64,
+    last_ack: Instant,
+    window: Window,
+}
+
+impl LinkReceiver {
+    /// Declares the subscriber of `key` (its queue holds a whole window)
+    /// and the publisher of its acks, and says hello.
+    pub fn open(session: &zenoh::Session, key: &str, window: Window) -> Result<Self, LinkError> {
+        let capacity = usize::try_from(window.window).unwrap_or(usize::MAX) + 16;
+        let data = session
+            .declare_subscriber(key.to_string())
+            .with(FifoChannel::new(capacity))
+            .wait()
+            .map_err(zerr)?;
+        let acks = session
+            .declare_publisher(super::keys::ack(key))
+            .congestion_control(CongestionControl::Block)
+            .express(true)
+            .wait()
+            .map_err(zerr)?;
+        let r = Self {
+            data,
+            acks,
+            delivered: 0,
+            last_ack: Instant::now(),
+            window,
+        };
+        r.ack()?;
+        Ok(r)
+    }
+
+    fn ack(&self) -> Result<(), LinkError> {
+        (self.acks)
+            .put(self.delivered.to_le_bytes().to_vec())
+            .wait()
+            .map_err(zerr)
+    }
+
+    /// The next message, waiting at most `timeout`; an idle receiver
+    /// repeats its acknowledgement every [`HELLO_EVERY`].
+    pub fn recv(&mut self, timeout: Duration) -> Result<Option<Vec<u8>>, LinkError> {
+        let got = self.data.recv_timeout(timeout).map_err(zerr)?;
+        if got.is_none() && self.last_ack.elapsed() >= HELLO_EVERY {
+            self.last_ack = Instant::now();
+            self.ack()?;
+        }
+        Ok(got.map(|s| s.payload().to_bytes().into_owned()))
+    }
+
+    /// Books one message as delivered (acknowledged every `ack_every`).
+    pub fn delivered(&mut self) -> Result<(), LinkError> {
+        self.delivered += 1;
+        if self.delivered % self.window.ack_every == 0 {
+            self.last_ack = Instant::now();
+            self.ack()?;
+        }
+        Ok(())
+    }
+}

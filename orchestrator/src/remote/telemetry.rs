@@ -1,0 +1,203 @@
+//! Telemetry across hosts: on a host, one thread reads every local node's
+//! telemetry service (woken, as an orchestrator is, by the nodes' events)
+//! and sends each message, prefixed by the id of the service it came from,
+//! on the host's telemetry link; on the orchestrator's side one thread per
+//! host publishes each into the local telemetry service of that id, so the
+//! orchestrator collects remote nodes exactly as local ones (its sender
+//! check included).
+
+use super::keys;
+use super::link::{LinkReceiver, LinkSender, TELEMETRY_WINDOW};
+use super::local::{LocalNs, Shared};
+use iceoryx2::prelude::*;
+use msgs::bytes::Bytes;
+use msgs::iox::iox;
+use msgs::{Telemetry, TelemetryMsg};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// How long the forwarder sleeps on the wake event between drains (as the
+/// orchestrator does: samples do not notify).
+const POLL: Duration = Duration::from_millis(10);
+
+/// A thread of the telemetry bridge; stopped (through `Shared`) and joined on drop.
+pub struct TelemetryThread(Option<JoinHandle<()>>, Shared);
+
+impl Drop for TelemetryThread {
+    fn drop(&mut self) {
+        self.1.stop();
+        if let Some(t) = self.0.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// Prefixes `m` with the id of the service it came from.
+fn frame(service: u32, m: &TelemetryMsg) -> Vec<u8> {
+    let mut out = service.to_le_bytes().to_vec();
+    m.put(&mut out);
+    out
+}
+
+/// The service id and message of a frame.
+fn unframe(b: &[u8]) -> Result<(u32, TelemetryMsg), String> {
+    let (id, m) = b
+        .split_at_checked(4)
+        .ok_or("a telemetry frame of under 4 bytes")?;
+    let id = u32::from_le_bytes(id.try_into().expect("4 bytes"));
+    Ok((id, TelemetryMsg::from_bytes(m).map_err(|e| e.to_string())?))
+}
+
+/// What a telemetry thread works with.
+struct Ends {
+    session: zenoh::Session,
+    ns: LocalNs,
+    /// The link's key.
+    key: String,
+    /// The host's name.
+    host: String,
+    /// The host's nodes.
+    ids: Vec<u32>,
+    sh: Shared,
+}
+
+impl Ends {
+    /// Runs `f` on a thread of its own; its error is the run's failure.
+    fn spawn(self, what: &'static str, f: fn(&Ends) -> Result<(), String>) -> TelemetryThread {
+        let sh = self.sh.clone();
+        let t = std::thread::spawn(move || {
+            if let Err(e) = f(&self) {
+                self.sh.fail(format!("{what} of host {}: {e}", self.host));
+            }
+        });
+        TelemetryThread(Some(t), sh)
+    }
+}
+
+/// Which end of a host's telemetry link a thread is.
+#[derive(Debug, Clone, Copy)]
+pub enum End {
+    /// On the host: forwards its nodes' telemetry to the orchestrator.
+    Forward,
+    /// On the orchestrator's machine: publishes it into local services.
+    Sink,
+}
+
+/// Starts `end` of host `host`'s telemetry link in run `run`, for its nodes `ids`.
+#[must_use]
+pub fn start(
+    end: End,
+    session: &zenoh::Session,
+    ns: &LocalNs,
+    (run, host): (&str, &str),
+    ids: Vec<u32>,
+    sh: &Shared,
+) -> TelemetryThread {
+    let e = Ends {
+        session: session.clone(),
+        ns: ns.clone(),
+        key: keys::telemetry_link(run, host),
+        host: host.to_string(),
+        ids,
+        sh: sh.clone(),
+    };
+    match end {
+        End::Forward => e.spawn("telemetry bridge", forward_loop),
+        End::Sink => e.spawn("telemetry", sink_loop),
+    }
+}
+
+fn forward_loop(e: &Ends) -> Result<(), String> {
+    let (session, ns, key, ids, sh) = (&e.session, &e.ns, e.key.as_str(), e.ids.as_slice(), &e.sh);
+    let node = ns.node("host-telemetry").map_err(|e| e.to_string())?;
+    let wake = msgs::open::orchestrator_wake(&node, &ns.run, &ns.limits)
+        .map_err(|e| e.to_string())?
+        .listener_builder()
+        .create()
+        .map_err(|e| iox("telemetry wake listener")(e).to_string())?;
+    let subs = (ids.iter())
+        .map(|&id| {
+            msgs::open::telemetry(&node, &ns.run, id, &ns.limits)
+                .map_err(|e| e.to_string())?
+                .subscriber_builder()
+                .buffer_size(ns.limits.telemetry_buffer)
+                .create()
+                .map_err(|e| iox("telemetry subscriber")(e).to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut link = LinkSender::open(session, key, TELEMETRY_WINDOW).map_err(|e| e.to_string())?;
+    let stop = || false;
+    loop {
+        // Drain once more after the stop: the last reports (Done, Failed) go too.
+        let last = sh.stopping();
+        let _ = wake.timed_wait(|_| {}, POLL);
+        for (sub, &id) in subs.iter().zip(ids) {
+            while let Some(m) = sub.receive().map_err(|e| format!("{e:?}"))? {
+                let bytes = frame(id, &m);
+                drop(m);
+                link.send(bytes, ns.stage_timeout, &stop)
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        if last {
+            return Ok(());
+        }
+    }
+}
+
+fn sink_loop(e: &Ends) -> Result<(), String> {
+    let (session, ns, key, ids, sh) = (&e.session, &e.ns, e.key.as_str(), e.ids.as_slice(), &e.sh);
+    let host = e.host.as_str();
+    let node = ns
+        .node(&format!("telemetry-of-{host}"))
+        .map_err(|e| e.to_string())?;
+    let pubs = (ids.iter())
+        .map(|&id| {
+            msgs::open::telemetry(&node, &ns.run, id, &ns.limits)
+                .map_err(|e| e.to_string())?
+                .publisher_builder()
+                .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
+                .create()
+                .map_err(|e| iox("telemetry publisher")(e).to_string())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let wake = msgs::open::orchestrator_wake(&node, &ns.run, &ns.limits)
+        .map_err(|e| e.to_string())?
+        .notifier_builder()
+        .create()
+        .map_err(|e| iox("orchestrator notifier")(e).to_string())?;
+    let mut link = LinkReceiver::open(session, key, TELEMETRY_WINDOW).map_err(|e| e.to_string())?;
+    while !sh.stopping() {
+        let Some(b) = link.recv(POLL).map_err(|e| e.to_string())? else {
+            continue;
+        };
+        let (id, m) = unframe(&b)?;
+        let k = (ids.iter().position(|&i| i == id))
+            .ok_or_else(|| format!("telemetry of node {id}, which is not placed on it"))?;
+        pubs[k]
+            .send_copy(m)
+            .map_err(|e| iox("telemetry send")(e).to_string())?;
+        let sample = matches!(
+            m.decode(),
+            Ok(Telemetry::Sample { .. } | Telemetry::LeaderSample { .. })
+        );
+        if !sample {
+            let _ = wake.notify();
+        }
+        link.delivered().map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_frame_carries_its_service_id_and_the_exact_message() {
+        let m = TelemetryMsg::encode(9, &Telemetry::Ready);
+        let (id, back) = unframe(&frame(4, &m)).expect("a frame");
+        assert_eq!((id, back), (4, m));
+        assert!(unframe(&[1, 2]).is_err());
+    }
+}

@@ -1,0 +1,106 @@
+//! The Zenoh configuration of every session attsync opens, always explicit:
+//! peer mode, the given listen and connect endpoints only (no default
+//! listener), multicast scouting and gossip off, and a short lease so that
+//! a lost peer is noticed within [`LEASE_MS`].
+
+use thiserror::Error;
+
+/// How long a silent link lives, ms (Zenoh's default is 10 000). A
+/// daemon killed outright closes its sockets and is noticed at once; a
+/// machine that vanishes is noticed after this.
+pub const LEASE_MS: u64 = 2000;
+
+/// An endpoint Zenoh does not accept, or a session that cannot open.
+#[derive(Debug, Error)]
+pub enum ConfigError {
+    /// An endpoint is not in Zenoh's syntax (`tcp/127.0.0.1:7447`).
+    #[error("{flag}: `{endpoint}` is not an endpoint (expected e.g. tcp/127.0.0.1:7447): {reason}")]
+    Endpoint {
+        /// Where it came from (`--listen`, a host's `endpoint`…).
+        flag: String,
+        /// The text.
+        endpoint: String,
+        /// Zenoh's reason.
+        reason: String,
+    },
+    /// The session did not open (a port taken, …).
+    #[error("zenoh: cannot open the session: {0}")]
+    Open(String),
+}
+
+/// Checks `endpoint` (from `flag`): Zenoh's syntax, and TCP (the only
+/// transport attsync builds).
+pub fn check_endpoint(flag: &str, endpoint: &str) -> Result<(), ConfigError> {
+    let bad = |reason: String| ConfigError::Endpoint {
+        flag: flag.to_string(),
+        endpoint: endpoint.to_string(),
+        reason,
+    };
+    let e: zenoh::config::EndPoint = endpoint.parse().map_err(|e| bad(format!("{e}")))?;
+    if e.protocol().as_str() != "tcp" {
+        return Err(bad("only tcp/ endpoints are supported".into()));
+    }
+    Ok(())
+}
+
+/// The configuration of a peer that listens on `listen` and dials `connect`.
+pub fn peer(listen: &[String], connect: &[String]) -> Result<zenoh::Config, ConfigError> {
+    let mut c = zenoh::Config::default();
+    let list = |v: &[String]| serde_json::to_string(v).expect("strings serialise");
+    let settings = [
+        ("mode", "\"peer\"".to_string()),
+        ("listen/endpoints", list(listen)),
+        ("connect/endpoints", list(connect)),
+        // Dial in the background, again and again (a host started before
+        // the host it dials, a host restarted), every 100 ms to 1 s.
+        ("connect/timeout_ms", "-1".into()),
+        ("connect/exit_on_failure", "false".into()),
+        (
+            "connect/retry",
+            r#"{"period_init_ms": 100, "period_max_ms": 1000, "period_increase_factor": 2}"#.into(),
+        ),
+        ("scouting/multicast/enabled", "false".into()),
+        ("scouting/gossip/enabled", "false".into()),
+        ("transport/link/tx/lease", LEASE_MS.to_string()),
+    ];
+    for (key, value) in settings {
+        c.insert_json5(key, &value)
+            .map_err(|e| ConfigError::Open(format!("{key} = {value}: {e}")))?;
+    }
+    Ok(c)
+}
+
+/// Opens a peer session ([`peer`]).
+pub fn open(listen: &[String], connect: &[String]) -> Result<zenoh::Session, ConfigError> {
+    use zenoh::Wait;
+    zenoh::open(peer(listen, connect)?)
+        .wait()
+        .map_err(|e| ConfigError::Open(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn endpoints_are_checked_naming_the_flag() {
+        assert!(check_endpoint("--listen", "tcp/127.0.0.1:7447").is_ok());
+        let e = check_endpoint("--listen", "127.0.0.1:7447").unwrap_err();
+        assert!(
+            e.to_string().starts_with("--listen: `127.0.0.1:7447`"),
+            "{e}"
+        );
+        let e = check_endpoint("--connect", "udp/127.0.0.1:7447").unwrap_err();
+        assert!(e.to_string().contains("only tcp/"), "{e}");
+    }
+
+    #[test]
+    fn the_configuration_is_explicit() {
+        let c = peer(&["tcp/127.0.0.1:0".into()], &[]).expect("valid");
+        let json = |k: &str| c.get_json(k).expect(k);
+        assert_eq!(json("scouting/multicast/enabled"), "false");
+        assert_eq!(json("scouting/gossip/enabled"), "false");
+        assert_eq!(json("listen/endpoints"), r#"["tcp/127.0.0.1:0"]"#);
+        assert_eq!(json("connect/endpoints"), "[]");
+    }
+}

@@ -1,0 +1,81 @@
+//! Across hosts, beyond the paper's runs (issue 12): `[network]`
+//! impairments (simulated on the receiving side, so unchanged across
+//! hosts) and a generated 30-agent tree over three hosts, each
+//! byte-identical to the in-process engine, nothing left on any host.
+
+use attsync_tests::{
+    Attsync, Daemon, Sandbox, assert_hosts_clean, assert_same_results, hosts_file, paper, run_args,
+    run_on_hosts,
+};
+use std::path::Path;
+
+/// Runs `scenario` (with `sets`) over `hosts` and in-process; asserts
+/// identical results.
+fn parity(tmp: &Sandbox, scenario: &Path, sets: &[&str], hosts: &Path) {
+    let (p, i) = (tmp.join("hosts"), tmp.join("in-process"));
+    run_on_hosts(tmp.path(), scenario, &p, sets, hosts)
+        .output()
+        .assert_ok()
+        .assert_no_leftovers();
+    Attsync::new(tmp.path())
+        .args(run_args(scenario, "in-process", &i, sets))
+        .output()
+        .assert_ok();
+    assert_same_results(&p, &i);
+}
+
+#[test]
+fn impairments_are_simulated_on_the_receiving_side_across_hosts_too() {
+    let tmp = Sandbox::new("hosts-impaired");
+    let a = Daemon::start("a", &[]);
+    let hosts = hosts_file(tmp.path(), "hosts.toml", &[(&a, true, &[2, 4, 6])]);
+    let sets = [
+        "simulation.duration=2",
+        "network.delay=0.02",
+        "network.loss=0.1",
+        "network.seed=7",
+    ];
+    parity(&tmp, &paper("constant-observerless"), &sets, &hosts);
+    let s = attsync_tests::summary(&tmp.join("hosts"));
+    let links = s["links"].as_array().expect("impaired links are reported");
+    assert!(
+        links
+            .iter()
+            .any(|l| l["lost"].as_u64().is_some_and(|n| n > 0)),
+        "{s:#}"
+    );
+    assert_hosts_clean(&[&a]);
+}
+
+#[test]
+fn a_thirty_agent_tree_over_three_hosts_is_byte_identical() {
+    let tmp = Sandbox::new("hosts-tree30");
+    let tree = tmp.join("tree.toml");
+    Attsync::new(tmp.path())
+        .args([
+            "gen",
+            "tree",
+            "--agents",
+            "30",
+            "--seed",
+            "3",
+            "--scheme",
+            "observerless",
+        ])
+        .args(["--duration", "1", "--out"])
+        .args([&tree])
+        .output()
+        .assert_ok();
+    let a = Daemon::start("a", &[]);
+    let b = Daemon::start("b", &[&a]);
+    let c = Daemon::start("c", &[&a, &b]);
+    let (on_a, on_b, on_c): (Vec<u32>, Vec<u32>, Vec<u32>) =
+        ((1..=10).collect(), (11..=20).collect(), (21..=28).collect());
+    let hosts = hosts_file(
+        tmp.path(),
+        "hosts.toml",
+        &[(&a, false, &on_a), (&b, true, &on_b), (&c, false, &on_c)],
+    );
+    parity(&tmp, &tree, &[], &hosts);
+    assert_hosts_clean(&[&a, &b, &c]);
+}
