@@ -130,25 +130,7 @@ fn start(
 pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: Receiver<Command>) {
     let shared = Shared::default();
     // Declared before the answer, so that no command of the run is missed.
-    let control = session.declare_subscriber(keys::control(&req.run)).wait();
-    let events = session
-        .declare_publisher(keys::events(&req.run, &req.host))
-        .wait();
-    let (alive, lost) = (
-        Arc::new(AtomicBool::new(false)),
-        Arc::new(AtomicBool::new(false)),
-    );
-    let (a, l) = (alive.clone(), lost.clone());
-    let watch = session
-        .liveliness()
-        .declare_subscriber(keys::orchestrator_alive(&req.run))
-        .history(true)
-        .callback(move |s| match s.kind() {
-            zenoh::sample::SampleKind::Put => a.store(true, Ordering::Relaxed),
-            zenoh::sample::SampleKind::Delete => l.store(true, Ordering::Relaxed),
-        })
-        .wait();
-    let (Ok(control), Ok(events), Ok(_watch)) = (control, events, watch) else {
+    let Some(ports) = RunPorts::declare(&session, &req) else {
         answer(
             &reply,
             &Err("zenoh: cannot declare the run's subscribers".into()),
@@ -166,18 +148,87 @@ pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: R
     answer(&reply, &Ok(()));
     drop(reply); // its final reply: the orchestrator's query completes
     tracing::info!(run = %req.run, nodes = nodes.len(), "run started");
-    let began = Instant::now();
     let mut exits: Vec<Option<Exit>> = (0..nodes.len()).map(|_| None).collect();
-    let mut failed_said = false;
-    let put = |e: &HostEvent| {
-        let _ = events
+    let end = watch(
+        &req, &ports, &mut res, &nodes, &shared, &mut exits, &commands,
+    );
+    let kill = end.as_ref().is_none_or(|(e, _)| e.kill);
+    let (logs, leftovers) = wind_down(&req, res, &nodes, &mut exits, kill);
+    if let Some((_, q)) = end {
+        reply_end(&q, &nodes, exits, logs, leftovers);
+    }
+}
+
+/// The run's Zenoh ports on this host: the orchestrator's commands, this
+/// host's events, and whether the orchestrator is (still) alive.
+struct RunPorts {
+    control: zenoh::pubsub::Subscriber<zenoh::handlers::FifoChannelHandler<zenoh::sample::Sample>>,
+    events: zenoh::pubsub::Publisher<'static>,
+    _watch: zenoh::pubsub::Subscriber<()>,
+    alive: Arc<AtomicBool>,
+    lost: Arc<AtomicBool>,
+}
+
+impl RunPorts {
+    /// Declares them (`None` if Zenoh refuses one).
+    fn declare(session: &zenoh::Session, req: &RunRequest) -> Option<RunPorts> {
+        let control = session.declare_subscriber(keys::control(&req.run)).wait();
+        let events = session
+            .declare_publisher(keys::events(&req.run, &req.host))
+            .wait();
+        let (alive, lost) = (
+            Arc::new(AtomicBool::new(false)),
+            Arc::new(AtomicBool::new(false)),
+        );
+        let (a, l) = (alive.clone(), lost.clone());
+        let watch = session
+            .liveliness()
+            .declare_subscriber(keys::orchestrator_alive(&req.run))
+            .history(true)
+            .callback(move |s| match s.kind() {
+                zenoh::sample::SampleKind::Put => a.store(true, Ordering::Relaxed),
+                zenoh::sample::SampleKind::Delete => l.store(true, Ordering::Relaxed),
+            })
+            .wait();
+        let (Ok(control), Ok(events), Ok(_watch)) = (control, events, watch) else {
+            return None;
+        };
+        Some(RunPorts {
+            control,
+            events,
+            _watch,
+            alive,
+            lost,
+        })
+    }
+
+    /// Sends a [`HostEvent`] to the orchestrator.
+    fn put(&self, e: &HostEvent) {
+        let _ = self
+            .events
             .put(serde_json::to_vec(e).expect("serialises"))
             .wait();
-    };
-    let end = loop {
+    }
+}
+
+/// The running phase: reports exits and the first failure, relays the
+/// orchestrator's control messages, until the orchestrator ends the run
+/// (`Some`), or aborts it or is gone (`None`).
+fn watch(
+    req: &RunRequest,
+    ports: &RunPorts,
+    res: &mut Resources,
+    nodes: &Nodes,
+    shared: &Shared,
+    exits: &mut [Option<Exit>],
+    commands: &Receiver<Command>,
+) -> Option<(EndRequest, Query)> {
+    let began = Instant::now();
+    let mut failed_said = false;
+    loop {
         while let Some(e) = res.sup.try_exit() {
             let (id, _, log) = &nodes[e.index];
-            put(&HostEvent::Exited {
+            ports.put(&HostEvent::Exited {
                 id: *id,
                 status: describe(&e.status),
                 clean: matches!(&e.status, Ok(s) if s.success()),
@@ -186,30 +237,40 @@ pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: R
             let k = e.index;
             exits[k] = Some(e);
         }
-        while let Ok(Some(s)) = control.try_recv() {
+        while let Ok(Some(s)) = ports.control.try_recv() {
             if let Ok(m) = ControlMsg::from_bytes(&s.payload().to_bytes()) {
                 let _ = res.control.send_copy(m);
             }
         }
         if let (Some(f), false) = (shared.failure(), failed_said) {
             failed_said = true;
-            put(&HostEvent::Failed(f));
+            ports.put(&HostEvent::Failed(f));
         }
-        let gone = lost.load(Ordering::Relaxed)
-            || (!alive.load(Ordering::Relaxed) && began.elapsed() > ORCHESTRATOR_GRACE);
+        let gone = ports.lost.load(Ordering::Relaxed)
+            || (!ports.alive.load(Ordering::Relaxed) && began.elapsed() > ORCHESTRATOR_GRACE);
         if gone {
             tracing::warn!(run = %req.run, "the orchestrator is gone: cleaning the run up");
-            break None;
+            return None;
         }
         match commands.recv_timeout(TICK) {
-            Ok(Command::End(e, q)) => break Some((e, q)),
+            Ok(Command::End(e, q)) => return Some((e, q)),
             Ok(Command::Abort) | Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
-                break None;
+                return None;
             }
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
         }
-    };
-    let kill = end.as_ref().is_none_or(|(e, _)| e.kill);
+    }
+}
+
+/// Stops the nodes (killed unless the run ended cleanly), collects their
+/// exits and logs, removes the namespace; the logs and what was left.
+fn wind_down(
+    req: &RunRequest,
+    mut res: Resources,
+    nodes: &Nodes,
+    exits: &mut [Option<Exit>],
+    kill: bool,
+) -> (Vec<Vec<u8>>, Vec<String>) {
     if kill {
         res.sup.kill_all();
     }
@@ -229,7 +290,17 @@ pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: R
         .map(|p| p.display().to_string())
         .collect();
     tracing::info!(run = %req.run, "run ended, namespace removed");
-    let Some((_, q)) = end else { return };
+    (logs, leftovers)
+}
+
+/// The answer to the orchestrator's end request: each node's exit and log.
+fn reply_end(
+    q: &Query,
+    nodes: &Nodes,
+    exits: Vec<Option<Exit>>,
+    logs: Vec<Vec<u8>>,
+    leftovers: Vec<String>,
+) {
     let reply = EndReply {
         nodes: (nodes.iter().zip(exits).zip(logs))
             .map(|(((id, _, _), e), log)| NodeEnd {
