@@ -1,7 +1,8 @@
 //! A node's log: its stdout and stderr, piped through the orchestrator into
 //! `logs/<node>.log` and cut at [`LOG_CAP`] (past it one [`CUT_LINE`] is
 //! written and the rest drained, so the node never blocks on a full pipe);
-//! [`tail`] reads only the end of a log.
+//! [`tail`] reads only the end of a log, [`last_bytes`] its end as bytes
+//! (what a host daemon sends back of a remote node's log).
 
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom, Write};
@@ -13,8 +14,8 @@ use tokio::process::{ChildStderr, ChildStdout};
 pub const LOG_CAP: u64 = 16 << 20;
 /// The line that ends a log cut at [`LOG_CAP`].
 pub const CUT_LINE: &str = "[attsync: log cut at 16 MiB; further output discarded]";
-/// How much of the end of a log [`tail`] reads.
-const TAIL_BYTES: u64 = 64 << 10;
+/// How much of the end of a log [`tail`] and [`last_bytes`] read.
+pub const TAIL_BYTES: u64 = 64 << 10;
 
 /// A log file that takes at most `cap` bytes of output.
 #[derive(Debug)]
@@ -102,21 +103,42 @@ pub async fn copy_capped(
 /// decoded lossily (empty if unreadable).
 #[must_use]
 pub fn tail(log: &Path, n: usize) -> String {
+    let (bytes, _) = last_bytes(log);
+    let text = String::from_utf8_lossy(&bytes);
+    let lines: Vec<&str> = text.lines().collect();
+    lines[lines.len().saturating_sub(n)..].join("\n")
+}
+
+/// The end of a log file: at most its last [`TAIL_BYTES`], from the first
+/// line that starts within them (the whole file if it is no longer), and
+/// how many bytes before that were left out (nothing if unreadable).
+#[must_use]
+pub fn last_bytes(log: &Path) -> (Vec<u8>, u64) {
     let Ok(mut file) = File::open(log) else {
-        return String::new();
+        return (Vec::new(), 0);
     };
     let len = file.metadata().map_or(0, |m| m.len());
     let start = len.saturating_sub(TAIL_BYTES);
     let mut bytes = Vec::new();
     if file.seek(SeekFrom::Start(start)).is_err() || file.read_to_end(&mut bytes).is_err() {
-        return String::new();
+        return (Vec::new(), 0);
     }
-    let text = String::from_utf8_lossy(&bytes);
-    let mut lines: Vec<&str> = text.lines().collect();
-    if start > 0 && !lines.is_empty() {
-        lines.remove(0); // cut in the middle
+    if start == 0 {
+        return (bytes, 0);
     }
-    lines[lines.len().saturating_sub(n)..].join("\n")
+    // Cut in the middle of a line: start at the next one.
+    let skip = bytes.iter().position(|&b| b == b'\n').map_or(0, |i| i + 1);
+    (bytes.split_off(skip), start + skip as u64)
+}
+
+/// The line that heads a log of which only the end is kept (`cut` bytes
+/// before it left out, on `host`).
+#[must_use]
+pub fn cut_note(host: &str, cut: u64) -> String {
+    format!(
+        "[attsync: the first {cut} bytes of this log were cut on host {host}; only its last {} KiB came back]",
+        TAIL_BYTES >> 10
+    )
 }
 
 #[cfg(test)]
@@ -172,5 +194,24 @@ mod tests {
         std::fs::write(&path, data).unwrap();
         assert_eq!(tail(&path, 2), "bad \u{fffd}\u{fffd} bytes\nlast");
         assert!(tail(&path, 100_000).lines().count() < 14_000);
+    }
+
+    #[test]
+    fn last_bytes_start_at_a_line_and_count_what_was_cut() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.log");
+        std::fs::write(&path, b"short\nlog\n").unwrap();
+        assert_eq!(last_bytes(&path), (b"short\nlog\n".to_vec(), 0));
+        let line = b"0123456789abcde\n"; // 16 bytes
+        let data = line.repeat(10_000);
+        std::fs::write(&path, &data).unwrap();
+        let (end, cut) = last_bytes(&path);
+        assert_eq!(end.len() as u64 + cut, data.len() as u64);
+        assert!(
+            end.len() as u64 <= TAIL_BYTES && end.starts_with(line),
+            "{cut}"
+        );
+        assert_eq!(cut % 16, 0);
+        assert!(last_bytes(&dir.path().join("none")).0.is_empty());
     }
 }

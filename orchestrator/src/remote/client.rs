@@ -11,11 +11,13 @@ use super::keys;
 use super::local::{LocalNs, Shared};
 use super::plan::{Plan, links};
 use super::telemetry::{self, End, TelemetryThread};
-use super::wire::{Answer, EndReply, EndRequest, HostEvent, RemoteNode, RunRequest};
+use super::wire::{Answer, EndReply, EndRequest, HostEvent, NodeEnd, RemoteNode, RunRequest};
 use super::zconfig;
+use crate::processes::node_log::cut_note;
 use msgs::ControlMsg;
 use msgs::bytes::Bytes;
 use msgs::config::NodeConfig;
+use std::io::Write;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -338,7 +340,7 @@ impl Remote {
             };
             for n in reply.nodes {
                 let file = logs.join(crate::results::layout::node_log_file(&node_name(n.id)));
-                let _ = std::fs::write(&file, &n.log);
+                let _ = write_log(&file, &name, &n);
                 if !n.clean {
                     bad.push(RemoteExit {
                         id: n.id,
@@ -358,6 +360,16 @@ impl Remote {
         self.bridges = None;
         bad
     }
+}
+
+/// Writes a remote node's log: the end the host sent, headed by
+/// [`cut_note`] if the host cut its beginning.
+fn write_log(file: &Path, host: &str, n: &NodeEnd) -> std::io::Result<()> {
+    let mut f = std::fs::File::create(file)?;
+    if n.cut > 0 {
+        writeln!(f, "{}", cut_note(host, n.cut))?;
+    }
+    f.write_all(&n.log)
 }
 
 /// `leader`, `agent-<id>`.

@@ -12,6 +12,7 @@ use super::local::{LocalNs, Shared};
 use super::telemetry::{self, End, TelemetryThread};
 use super::wire::{EndReply, EndRequest, HostEvent, NodeEnd, RunRequest};
 use crate::processes::namespace::Namespace;
+use crate::processes::node_log::last_bytes;
 use crate::processes::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
 use iceoryx2::prelude::*;
 use msgs::ControlMsg;
@@ -263,14 +264,15 @@ fn watch(
 }
 
 /// Stops the nodes (killed unless the run ended cleanly), collects their
-/// exits and logs, removes the namespace; the logs and what was left.
+/// exits and the ends of their logs, removes the namespace; the logs'
+/// ends and what was left.
 fn wind_down(
     req: &RunRequest,
     mut res: Resources,
     nodes: &Nodes,
     exits: &mut [Option<Exit>],
     kill: bool,
-) -> (Vec<Vec<u8>>, Vec<String>) {
+) -> (Vec<(Vec<u8>, u64)>, Vec<String>) {
     if kill {
         res.sup.kill_all();
     }
@@ -279,10 +281,7 @@ fn wind_down(
         let k = e.index;
         exits[k] = Some(e);
     }
-    let logs: Vec<Vec<u8>> = nodes
-        .iter()
-        .map(|(_, _, log)| std::fs::read(log).unwrap_or_default())
-        .collect();
+    let logs: Vec<(Vec<u8>, u64)> = nodes.iter().map(|(_, _, log)| last_bytes(log)).collect();
     let local_run = res.ns.run().to_string();
     drop(res);
     let leftovers = Namespace::leftovers(&local_run)
@@ -293,23 +292,25 @@ fn wind_down(
     (logs, leftovers)
 }
 
-/// The answer to the orchestrator's end request: each node's exit and log.
+/// The answer to the orchestrator's end request: each node's exit and the
+/// end of its log (bounded: [`last_bytes`]).
 fn reply_end(
     q: &Query,
     nodes: &Nodes,
     exits: Vec<Option<Exit>>,
-    logs: Vec<Vec<u8>>,
+    logs: Vec<(Vec<u8>, u64)>,
     leftovers: Vec<String>,
 ) {
     let reply = EndReply {
         nodes: (nodes.iter().zip(exits).zip(logs))
-            .map(|(((id, _, _), e), log)| NodeEnd {
+            .map(|(((id, _, _), e), (log, cut))| NodeEnd {
                 id: *id,
                 status: e
                     .as_ref()
                     .map_or("still running".into(), |e| describe(&e.status)),
                 clean: e.is_some_and(|e| matches!(&e.status, Ok(s) if s.success())),
                 log,
+                cut,
             })
             .collect(),
         leftovers,
