@@ -114,7 +114,10 @@ fn lockstep_with_the_delay_simulated_is_byte_identical_despite_the_real_one() {
     assert_same_results(&p, &i);
     let s = summary(&p);
     assert_eq!(s["complete"], true, "{s:#}");
-    eprintln!("lockstep over the delayed link: {} s wall", s["wall_seconds"]);
+    eprintln!(
+        "lockstep over the delayed link: {} s wall",
+        s["wall_seconds"]
+    );
     let links = s["links"].as_array().expect("impaired links are reported");
     assert_eq!(links.len(), CUT.len(), "{s:#}");
     for l in links {
