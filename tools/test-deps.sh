@@ -15,21 +15,23 @@ for req in examples/python/requirements.txt tests/requirements.txt; do
         python3 -m pip install -q -r "$req"
     fi
 done
-if ! command -v chromium >/dev/null 2>&1; then
+# apt_install PACKAGE WHY COMMAND…: installs Debian's PACKAGE (as root, with
+# apt) unless every COMMAND is there already; otherwise says WHY it is needed.
+apt_install() {
+    local package=$1 why=$2
+    shift 2
+    local c missing=
+    for c in "$@"; do
+        command -v "$c" >/dev/null 2>&1 || missing=1
+    done
+    [ -z "$missing" ] && return 0
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
         apt-get update -qq >/dev/null
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "$package" >/dev/null
     else
-        echo "tools/test-deps.sh: Chromium is missing (the browser test needs /usr/bin/chromium): install Debian's package 'chromium' as root" >&2
+        echo "tools/test-deps.sh: $* missing ($why): install Debian's package '$package' as root" >&2
         exit 1
     fi
-fi
-if ! command -v ip >/dev/null 2>&1 || ! command -v tc >/dev/null 2>&1; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        apt-get update -qq >/dev/null
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq iproute2 >/dev/null
-    else
-        echo "tools/test-deps.sh: ip/tc are missing (the network namespace tests need them): install Debian's package 'iproute2' as root" >&2
-        exit 1
-    fi
-fi
+}
+apt_install chromium "the browser test needs /usr/bin/chromium" chromium
+apt_install iproute2 "the network namespace tests need them" ip tc
