@@ -92,7 +92,7 @@ impl Veth {
     /// `tc qdisc add dev <end> root netem delay <delay>` on both ends, so
     /// that every packet across waits `delay` (a round trip twice that).
     /// `Err` with `tc`'s words if it refuses (a kernel built without
-    /// `sch_netem`, as some VMs' are).
+    /// `sch_netem`, as some VMs' are), neither end then delayed.
     pub fn netem_delay(&self, delay: Duration) -> Result<(), String> {
         let d = format!("{}us", delay.as_micros());
         let netem = ["qdisc", "add", "dev"];
@@ -101,15 +101,18 @@ impl Veth {
             a.extend([dev, "root", "netem", "delay", &d].map(String::from));
             a
         };
-        for out in [
+        let outs = [
             run(Command::new("tc").args(args(&self.root_if))),
             run(self.in_host("tc").args(args(&self.host_if))),
-        ] {
-            if !out.status.success() {
-                return Err(String::from_utf8_lossy(&out.stderr).trim().to_string());
-            }
-        }
-        Ok(())
+        ];
+        let Some(failed) = outs.iter().find(|o| !o.status.success()) else {
+            return Ok(());
+        };
+        // Neither end delayed, rather than one.
+        let del = |dev: &str| ["qdisc", "del", "dev", dev, "root"].map(String::from);
+        let _ = run(Command::new("tc").args(del(&self.root_if)));
+        let _ = run(self.in_host("tc").args(del(&self.host_if)));
+        Err(String::from_utf8_lossy(&failed.stderr).trim().to_string())
     }
 }
 
