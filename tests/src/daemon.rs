@@ -15,8 +15,10 @@ use std::time::Duration;
 pub struct Daemon {
     /// Its sandbox.
     pub host: HostSandbox,
-    /// Its endpoint, `tcp/127.0.0.1:<port>`.
+    /// Its endpoint, `tcp/127.0.0.1:<port>`: where the others dial it.
     pub endpoint: String,
+    /// Where it listens (its endpoint, unless a relay is in between).
+    listen: String,
     connect: Vec<String>,
     process: Option<HostProcess>,
 }
@@ -25,9 +27,23 @@ impl Daemon {
     /// Starts host `name` on a free port, dialling the hosts `connect`.
     #[must_use]
     pub fn start(name: &str, connect: &[&Daemon]) -> Self {
+        let endpoint = format!("tcp/127.0.0.1:{}", free_port());
+        Self::start_on(HostSandbox::new(name), &endpoint, endpoint.clone(), connect)
+    }
+
+    /// Starts a daemon in `host`, listening on `listen`, dialled by the
+    /// others at `endpoint` (the same, or a relay's), dialling `connect`.
+    #[must_use]
+    pub fn start_on(
+        host: HostSandbox,
+        listen: &str,
+        endpoint: String,
+        connect: &[&Daemon],
+    ) -> Self {
         let mut d = Self {
-            host: HostSandbox::new(name),
-            endpoint: format!("tcp/127.0.0.1:{}", free_port()),
+            host,
+            endpoint,
+            listen: listen.to_string(),
             connect: connect.iter().map(|c| c.endpoint.clone()).collect(),
             process: None,
         };
@@ -44,13 +60,7 @@ impl Daemon {
     /// Starts the daemon (again): same name, endpoint and peers.
     pub fn restart(&mut self) {
         let mut cmd = Command::new(bin("attsync"));
-        cmd.args([
-            "host",
-            "--name",
-            self.host.name(),
-            "--listen",
-            &self.endpoint,
-        ]);
+        cmd.args(["host", "--name", self.host.name(), "--listen", &self.listen]);
         for c in &self.connect {
             cmd.args(["--connect", c]);
         }

@@ -11,8 +11,11 @@
 //! a daemon, then the same daemon restarted) and its `/dev/shm` can still be
 //! listed after they died ([`HostSandbox::shm_entries`]: the "nothing left"
 //! check). Dropping the sandbox kills every process in its namespace.
-//! Networking is the machine's: use 127.0.0.1 and [`free_port`].
+//! Networking is the machine's (use 127.0.0.1 and [`free_port`]), or, for
+//! [`HostSandbox::networked`], a network namespace of the host's own with
+//! a veth pair to ours ([`Veth`]: its addresses, a real delay with netem).
 
+use crate::netns::Veth;
 use crate::{Sandbox, wait_until};
 use std::collections::BTreeSet;
 use std::fs::{self, File};
@@ -44,6 +47,8 @@ pub struct HostSandbox {
     namespace: PathBuf,
     dir: Sandbox,
     spawned: usize,
+    /// The link to a network namespace of its own, if it has one.
+    veth: Option<Veth>,
 }
 
 impl HostSandbox {
@@ -51,13 +56,41 @@ impl HostSandbox {
     /// cannot be made (`unshare --mount` needs root: CI runs as root).
     #[must_use]
     pub fn new(name: &str) -> Self {
+        Self::start(name, false)
+    }
+
+    /// A new host named `name` with, besides, a network namespace of its
+    /// own (`unshare --net`: loopback up, nothing else) joined to ours by
+    /// a veth pair ([`Self::veth`]). Its commands see only that network:
+    /// they reach the test's processes at [`Veth::root_addr`], and are
+    /// reached at [`Veth::host_addr`].
+    #[must_use]
+    pub fn networked(name: &str) -> Self {
+        let mut host = Self::start(name, true);
+        host.veth = Some(Veth::connect(host.holder.id()));
+        host
+    }
+
+    /// The veth pair to its network namespace ([`Self::networked`]).
+    #[must_use]
+    pub fn veth(&self) -> Option<&Veth> {
+        self.veth.as_ref()
+    }
+
+    fn start(name: &str, net: bool) -> Self {
         let dir = Sandbox::new(&format!("host-{name}"));
         fs::create_dir(dir.join("tmp")).expect("the host's TMPDIR");
+        let (flags, lo) = if net {
+            (["--mount", "--net"].as_slice(), "ip link set lo up && ")
+        } else {
+            (["--mount"].as_slice(), "")
+        };
         let mut holder = Command::new("unshare")
-            .args(["--mount", "--propagation", "private", "--", "sh", "-c"])
+            .args(flags)
+            .args(["--propagation", "private", "--", "sh", "-c"])
             // A private tmpfs on /dev/shm, then sleep in the namespace.
             .arg(format!(
-                "mount -t tmpfs -o mode=1777 tmpfs /dev/shm && echo {READY} && exec sleep infinity"
+                "{lo}mount -t tmpfs -o mode=1777 tmpfs /dev/shm && echo {READY} && exec sleep infinity"
             ))
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
@@ -87,6 +120,7 @@ impl HostSandbox {
             namespace,
             dir,
             spawned: 0,
+            veth: None,
         }
     }
 
@@ -125,6 +159,7 @@ impl HostSandbox {
             .arg("--no-fork")
             .arg(format!("--target={}", self.holder.id()))
             .arg("--mount")
+            .args(self.veth.as_ref().map(|_| "--net"))
             .arg(format!("--wd={}", wd.display()))
             .arg("--")
             .arg(cmd.get_program())
@@ -206,6 +241,8 @@ impl Drop for HostSandbox {
         }
         kill(&[format!("-{}", self.holder.id())]);
         let _ = self.holder.wait();
+        // After the holder: the veth pair goes with its namespace anyway.
+        self.veth.take();
     }
 }
 

@@ -28,7 +28,15 @@
 //!   [`assert_same_results`], [`staging_dir`].
 //! - `hosts.rs`: [`HostSandbox`], a simulated host (a mount namespace with
 //!   its own tmpfs on `/dev/shm` and its own `TMPDIR`) to start commands in
-//!   ([`HostProcess`]), its `/dev/shm` listed for leftovers; [`free_port`].
+//!   ([`HostProcess`]), its `/dev/shm` listed for leftovers; [`free_port`];
+//!   [`HostSandbox::networked`]: with a network namespace of its own too.
+//! - `netns.rs`: [`Veth`], the veth pair from our network namespace to a
+//!   host's (a /30 of 10.231.0.0/16 per pair, `tc … netem delay`),
+//!   [`link_exists`].
+//! - `delay_relay.rs`: [`DelayRelay`], a TCP relay adding a fixed delay each
+//!   way (the real delay where the kernel has no netem).
+//! - `delayed_host.rs`: [`DelayedHost`], a [`Daemon`] in a networked host
+//!   whose link has a real delay (netem, else a [`DelayRelay`]).
 //! - `conform.rs`: [`run_conform`] (`attsync conform` of a candidate),
 //!   [`rule_line`] (one rule's verdict in its report).
 //! - `daemon.rs`: [`Daemon`], an `attsync host` in a [`HostSandbox`] of its own;
@@ -45,8 +53,11 @@
 mod command;
 mod conform;
 mod daemon;
+mod delay_relay;
+mod delayed_host;
 mod hosts;
 mod namespace;
+mod netns;
 mod python;
 mod results;
 mod running;
@@ -57,10 +68,13 @@ mod workspace;
 pub use command::{Attsync, run_args};
 pub use conform::{rule_line, run_conform};
 pub use daemon::{Daemon, assert_hosts_clean, hosts_file, run_on_hosts};
+pub use delay_relay::DelayRelay;
+pub use delayed_host::{DAEMON_PORT, DelayKind, DelayedHost};
 pub use hosts::{HostProcess, HostSandbox, free_port};
 pub use namespace::{
     iox_base, kill9, node_pid, owned_run, owned_runs, run_leftovers, run_processes, signal,
 };
+pub use netns::{Veth, link_exists};
 pub use python::{conform_python, require_iceoryx2_module};
 pub use results::{
     assert_same_bytes, assert_same_file, assert_same_results, csv_agents, csv_rows, read,

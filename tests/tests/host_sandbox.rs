@@ -2,7 +2,8 @@
 //! issue 12): shared memory does not pass between a host and the machine,
 //! nor between two hosts; each host has its own `TMPDIR`; a host's
 //! processes die with it (even those that left its process group), and a
-//! process's group with its handle. Needs root (`unshare --mount`): CI runs
+//! process's group with its handle; a networked host has its own network
+//! (loopback and its veth end) and its veth pair goes with it. Needs root (`unshare --mount`): CI runs
 //! as root, and without it these tests fail, saying so.
 
 use attsync_tests::{HostProcess, HostSandbox, free_port, wait_until};
@@ -150,4 +151,43 @@ fn a_free_port_can_be_bound_on_the_loopback() {
         })
         .collect();
     assert!(tries.iter().any(|(_, l)| l.is_ok()), "{tries:?}");
+}
+
+#[test]
+fn a_networked_host_sees_its_own_network_only_and_its_veth_goes_with_it() {
+    let mut host = HostSandbox::networked("net");
+    let veth = host.veth().expect("a veth pair");
+    let (root_if, host_if) = (veth.root_if.clone(), veth.host_if.clone());
+    let (root_addr, host_addr) = (veth.root_addr, veth.host_addr);
+    let listed = sh(&mut host, "ip -4 -o addr show");
+    let names: Vec<&str> = (listed.lines())
+        .filter_map(|l| l.split_whitespace().nth(1))
+        .collect();
+    assert_eq!(names, ["lo", host_if.as_str()], "{listed}");
+    assert!(listed.contains(&format!("inet {host_addr}/30")), "{listed}");
+    // Our loopback is not the host's; our end of the veth is reachable.
+    let ours = std::net::TcpListener::bind(("127.0.0.1", 0)).unwrap();
+    let across = std::net::TcpListener::bind((root_addr, 0)).unwrap();
+    let dial = |addr: std::net::SocketAddr| {
+        format!(
+            "python3 -c 'import socket,sys\ntry: socket.create_connection((\"{}\", {}), 5); print(\"up\")\n\
+             except OSError: print(\"down\")'",
+            addr.ip(),
+            addr.port()
+        )
+    };
+    assert_eq!(
+        sh(&mut host, &dial(ours.local_addr().unwrap())).trim(),
+        "down"
+    );
+    assert_eq!(
+        sh(&mut host, &dial(across.local_addr().unwrap())).trim(),
+        "up"
+    );
+    assert!(attsync_tests::link_exists(&root_if));
+    drop(host);
+    assert!(
+        !attsync_tests::link_exists(&root_if),
+        "{root_if} outlived its host"
+    );
 }
