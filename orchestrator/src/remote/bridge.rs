@@ -93,30 +93,46 @@ impl Drop for Bridges {
 /// One link's sending end: a subscriber per receiver over there (the
 /// sender counts its receivers before it is ready), the first forwarded,
 /// the others drained.
+///
+/// The first is read into `queue` (at most a window) from the start, also
+/// while the window is shut: iceoryx2 0.10 holds a publisher back for a
+/// full subscriber only once that subscriber has received; before that its
+/// blocking send skips the subscriber without an error, and a sender
+/// running ahead (the leader) would lose its states from the 65th on.
 struct Outgoing {
     subs: Vec<iceoryx2::port::subscriber::Subscriber<ipc::Service, StateMsg, ()>>,
+    queue: std::collections::VecDeque<Vec<u8>>,
     link: LinkSender,
 }
 
 impl Outgoing {
-    /// Forwards what the window allows; whether anything moved.
+    /// Reads what the queue holds and forwards what the window allows;
+    /// whether anything moved.
     fn pump(&mut self) -> Result<bool, String> {
         let mut moved = false;
         for s in &self.subs[1..] {
             while s.receive().map_err(|e| format!("{e:?}"))?.is_some() {}
         }
-        while self.link.has_credit() {
+        while self.queue.len() < QUEUE {
             let Some(m) = self.subs[0].receive().map_err(|e| format!("{e:?}"))? else {
                 break;
             };
-            let bytes = m.to_bytes();
-            drop(m);
+            self.queue.push_back(m.to_bytes());
+            moved = true;
+        }
+        while self.link.has_credit() {
+            let Some(bytes) = self.queue.pop_front() else {
+                break;
+            };
             self.link.send_now(bytes).map_err(|e| e.to_string())?;
             moved = true;
         }
         Ok(moved)
     }
 }
+
+/// The states a link's sending end reads ahead of its window.
+const QUEUE: usize = STATE_WINDOW.window as usize;
 
 /// The sending side of every link leaving this side, on one thread that
 /// sleeps on the wake events of the receivers over there (nobody else
@@ -144,7 +160,11 @@ fn send_states(
             .collect::<Result<Vec<_>, _>>()?;
         let key = keys::state_link(run, l.from, &l.to_side);
         let link = LinkSender::open(session, &key, STATE_WINDOW).map_err(|e| e.to_string())?;
-        out.push(Outgoing { subs, link });
+        out.push(Outgoing {
+            subs,
+            queue: std::collections::VecDeque::new(),
+            link,
+        });
     }
     let mut remote: Vec<u32> = links
         .iter()
@@ -224,15 +244,64 @@ fn receive_states(
         if sh.stopping() {
             break;
         }
-        publisher
-            .send_copy(m)
-            .map_err(|e| iox("bridge state send")(e).to_string())?;
-        for n in &notifiers {
-            let _ = n.notify();
-        }
+        let to = Receivers {
+            notifiers: &notifiers,
+            want: l.receivers.len(),
+        };
+        deliver(&publisher, &to, m, ns.stage_timeout, sh)?;
         link.delivered().map_err(|e| e.to_string())?;
     }
     Ok(())
+}
+
+/// The local receivers of a bridged state: their wake events and how many
+/// subscribers a message must reach.
+struct Receivers<'a> {
+    notifiers: &'a [iceoryx2::port::notifier::Notifier<ipc::Service>],
+    want: usize,
+}
+
+/// Publishes `m` to every local receiver and wakes them. iceoryx2 0.10
+/// skips, without an error, a receiver whose buffer is full while its side
+/// of the connection is not established yet (it connects when it next
+/// polls): a send that reached nobody is repeated every 50 µs, waking the
+/// receivers, until it is delivered, at most `timeout`. Lockstep cannot
+/// lose a message, so one that reached only some of several receivers
+/// fails the run, named, instead of being skipped.
+fn deliver(
+    publisher: &iceoryx2::port::publisher::Publisher<ipc::Service, StateMsg, ()>,
+    to: &Receivers<'_>,
+    m: StateMsg,
+    timeout: Duration,
+    sh: &Shared,
+) -> Result<(), String> {
+    let start = std::time::Instant::now();
+    loop {
+        let got = (publisher.send_copy(m)).map_err(|e| iox("bridge state send")(e).to_string())?;
+        for n in to.notifiers {
+            let _ = n.notify();
+        }
+        if got >= to.want {
+            return Ok(());
+        }
+        let (step, stage) = (m.step, m.stage);
+        if got > 0 {
+            return Err(format!(
+                "step {step} stage {stage} reached {got} of its {} receivers here",
+                to.want
+            ));
+        }
+        if sh.stopping() {
+            return Ok(()); // the run is ending: nobody waits for it
+        }
+        if start.elapsed() > timeout {
+            return Err(format!(
+                "step {step} stage {stage} reached none of its receivers here in {:.1} s",
+                timeout.as_secs_f64()
+            ));
+        }
+        std::thread::sleep(Duration::from_micros(50));
+    }
 }
 
 /// A backpressure handler: retry every 50 µs, give up after `timeout` or
