@@ -12,6 +12,7 @@ use super::keys;
 use super::link::{LinkReceiver, LinkSender, STATE_WINDOW};
 use super::local::{LocalNs, Shared};
 use super::wire::StateLink;
+use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use msgs::StateMsg;
 use msgs::bytes::Bytes;
@@ -93,14 +94,10 @@ impl Drop for Bridges {
 /// One link's sending end: a subscriber per receiver over there (the
 /// sender counts its receivers before it is ready), the first forwarded,
 /// the others drained.
-///
-/// The first is read into `queue` (at most a window) from the start, also
-/// while the window is shut: iceoryx2 0.10 holds a publisher back for a
-/// full subscriber only once that subscriber has received; before that its
-/// blocking send skips the subscriber without an error, and a sender
-/// running ahead (the leader) would lose its states from the 65th on.
+/// The first is read into `queue` (at most a window) also while the
+/// window is shut.
 struct Outgoing {
-    subs: Vec<iceoryx2::port::subscriber::Subscriber<ipc::Service, StateMsg, ()>>,
+    subs: Vec<StateSubscriber>,
     queue: std::collections::VecDeque<Vec<u8>>,
     link: LinkSender,
 }
@@ -150,16 +147,14 @@ fn send_states(
     for l in links {
         let svc =
             msgs::open::state(&node, &ns.run, l.from, &ns.limits).map_err(|e| e.to_string())?;
-        let subs = (l.receivers.iter())
-            .map(|_| {
-                svc.subscriber_builder()
-                    .buffer_size(ns.limits.state_buffer)
-                    .create()
-                    .map_err(|e| iox("bridge state subscriber")(e).to_string())
-            })
-            .collect::<Result<Vec<_>, _>>()?;
         let key = keys::state_link(run, l.from, &l.to_side);
         let link = LinkSender::open(session, &key, STATE_WINDOW).map_err(|e| e.to_string())?;
+        if !publisher_is_up(&svc, sh) {
+            return Ok(()); // the run ended first
+        }
+        let subs = (l.receivers.iter())
+            .map(|_| subscribe(&svc, ns.limits.state_buffer))
+            .collect::<Result<Vec<_>, _>>()?;
         out.push(Outgoing {
             subs,
             queue: std::collections::VecDeque::new(),
@@ -205,6 +200,36 @@ fn send_states(
     }
     Ok(())
 }
+
+/// Waits until the sender's publisher exists (a node opens it before it
+/// waits for its receivers); `false` if the run stops first.
+fn publisher_is_up(svc: &StateService, sh: &Shared) -> bool {
+    while svc.dynamic_config().number_of_publishers() == 0 {
+        if sh.stopping() {
+            return false;
+        }
+        std::thread::sleep(Duration::from_micros(100));
+    }
+    true
+}
+
+/// A subscriber of the sender's states with its side of the connection to
+/// the (existing) publisher established before the sender can count it:
+/// iceoryx2 0.10 holds a publisher back for a full subscriber only once
+/// the subscriber's side is connected; before that its blocking send skips
+/// the subscriber without an error, and a sender that runs ahead (the
+/// leader) would lose its states from the 65th on.
+fn subscribe(svc: &StateService, buffer: usize) -> Result<StateSubscriber, String> {
+    let sub = (svc.subscriber_builder().buffer_size(buffer).create())
+        .map_err(|e| iox("bridge state subscriber")(e).to_string())?;
+    sub.update_connections()
+        .map_err(|e| format!("bridge state subscriber: {e:?}"))?;
+    Ok(sub)
+}
+
+type StateService =
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, StateMsg, ()>;
+type StateSubscriber = iceoryx2::port::subscriber::Subscriber<ipc::Service, StateMsg, ()>;
 
 /// The receiving side of `l`: the sender's only publisher on this side,
 /// holding back (like a node's own publisher) while a receiver's buffer is
