@@ -28,6 +28,8 @@
 //! - [`bare`]: one bare lockstep of `ring-node` processes; [`ring`]: one
 //!   `ring-node` process.
 //! - [`scale`]: `scale` — the in-process engine against N and threads.
+//! - [`zping`]: `zenoh-ping` — Zenoh's own round trip on loopback, next to
+//!   plain TCP (the floor under the bridge across hosts).
 //! - [`procs`]: child processes with bounded waits; [`stats`]: medians, CPU
 //!   load, the machine; [`error`]: [`error::BenchError`].
 
@@ -39,6 +41,7 @@ mod ring;
 mod scale;
 mod stats;
 mod suite;
+mod zping;
 
 use anyhow::{Context as _, bail};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -114,6 +117,33 @@ enum Cmd {
         /// Agent-steps per measurement.
         #[arg(long, default_value_t = scale::BUDGET)]
         budget: u64,
+    },
+    /// Zenoh's own round trip on loopback for a state-sized payload, with
+    /// attsync's session configuration: plain TCP (the floor), Zenoh's
+    /// default transport and its low-latency one, interleaved (a Markdown
+    /// table).
+    ZenohPing {
+        /// Payload bytes (a state on the bridge: 152).
+        #[arg(long, default_value_t = 152)]
+        payload: usize,
+        /// Round trips per measurement.
+        #[arg(long, default_value_t = 20_000)]
+        rounds: usize,
+        /// Round trips not counted, before each measurement.
+        #[arg(long, default_value_t = 2_000)]
+        warmup: usize,
+        /// Measurements per transport.
+        #[arg(long, default_value_t = 3)]
+        reps: usize,
+    },
+    /// (internal) The echoing end of `zenoh-ping`.
+    ZenohPong {
+        /// The ping's endpoint.
+        #[arg(long)]
+        connect: String,
+        /// What carries the pings.
+        #[arg(long, value_enum)]
+        transport: zping::Transport,
     },
     /// (internal) One process of the bare iceoryx2 lockstep ring.
     RingNode {
@@ -208,6 +238,13 @@ fn main() -> ExitCode {
 fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
     match cmd {
         Cmd::Burn => suite::burn(),
+        Cmd::ZenohPong { connect, transport } => zping::pong(&connect, transport),
+        Cmd::ZenohPing {
+            payload,
+            rounds,
+            warmup,
+            reps,
+        } => zenoh_ping_table(payload, rounds, warmup, reps),
         Cmd::Scale {
             agents,
             threads,
@@ -281,6 +318,43 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             run(opts, out)
         }
     }
+}
+
+/// `attsync-bench zenoh-ping`: `reps` measurements per transport,
+/// interleaved, each row printed as it comes.
+fn zenoh_ping_table(
+    payload: usize,
+    rounds: usize,
+    warmup: usize,
+    reps: usize,
+) -> anyhow::Result<()> {
+    println!(
+        "machine: {}; load average before: {}",
+        stats::machine(),
+        stats::loadavg()
+    );
+    println!("{}", zping::HEADER);
+    for _ in 0..reps {
+        for transport in [
+            zping::Transport::Tcp,
+            zping::Transport::Default,
+            zping::Transport::Lowlatency,
+        ] {
+            let port = std::net::TcpListener::bind("127.0.0.1:0")?
+                .local_addr()?
+                .port();
+            let p = zping::Ping {
+                payload,
+                rounds,
+                warmup,
+                transport,
+                port,
+            };
+            let rtt = zping::ping(p)?;
+            println!("{}", zping::row(&p, &rtt));
+        }
+    }
+    Ok(())
 }
 
 /// `attsync-bench scale`: measures every (scheme, N, threads), printing
