@@ -181,6 +181,7 @@ impl<'a> Session<'a> {
             dir: self.ports.dir().to_owned(),
             limits: Limits::of(self.net),
             stage_timeout: Duration::from_secs_f64(self.opts.stage_timeout),
+            realtime: self.opts.realtime.is_some(),
         };
         let (net, opts) = (self.net, self.opts);
         let node = |id: u32| {

@@ -5,11 +5,13 @@
 //! and publishes them into a local state service for that sender, with
 //! attsync's own service settings (`msgs::open::state`), waking the
 //! receivers. The receiving node sees a normal local input. The exact
-//! bytes travel, in order, losslessly: lockstep stays byte-identical.
+//! bytes travel, in order, losslessly: lockstep stays byte-identical. In
+//! real time the links carry the newest states first
+//! ([`super::link::STATE_FRESHEST`]), as a network would.
 
 use super::Side;
 use super::keys;
-use super::link::{LinkReceiver, LinkSender, STATE_WINDOW};
+use super::link::{Flow, LinkReceiver, LinkSender, STATE_FRESHEST, STATE_WINDOW};
 use super::local::{LocalNs, Shared};
 use super::wire::StateLink;
 use iceoryx2::port::update_connections::UpdateConnections;
@@ -128,8 +130,19 @@ impl Outgoing {
     }
 }
 
-/// The states a link's sending end reads ahead of its window.
-const QUEUE: usize = STATE_WINDOW.window as usize;
+/// The states a link's sending end reads ahead of its window (a state
+/// subscriber's buffer).
+const QUEUE: usize = 64;
+
+/// How `ns`'s cut edges carry states: every one in lockstep, the newest
+/// first in real time.
+fn state_flow(ns: &LocalNs) -> Flow {
+    if ns.realtime {
+        STATE_FRESHEST
+    } else {
+        STATE_WINDOW
+    }
+}
 
 /// The sending side of every link leaving this side, on one thread that
 /// sleeps on the wake events of the receivers over there (nobody else
@@ -148,7 +161,7 @@ fn send_states(
         let svc =
             msgs::open::state(&node, &ns.run, l.from, &ns.limits).map_err(|e| e.to_string())?;
         let key = keys::state_link(run, l.from, &l.to_side);
-        let link = LinkSender::open(session, &key, STATE_WINDOW).map_err(|e| e.to_string())?;
+        let link = LinkSender::open(session, &key, state_flow(ns)).map_err(|e| e.to_string())?;
         if !publisher_is_up(&svc, sh) {
             return Ok(()); // the run ended first
         }
@@ -260,7 +273,7 @@ fn receive_states(
                 .map_err(|e| iox("bridge wake notifier")(e).to_string())
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut link = LinkReceiver::open(session, key, STATE_WINDOW).map_err(|e| e.to_string())?;
+    let mut link = LinkReceiver::open(session, key, state_flow(ns)).map_err(|e| e.to_string())?;
     while !sh.stopping() {
         let Some(bytes) = link.recv(SLICE * 20).map_err(|e| e.to_string())? else {
             continue;

@@ -73,6 +73,7 @@ fn start(
         dir: ns.dir().to_owned(),
         limits: first.config.limits,
         stage_timeout: Duration::from_secs_f64(first.config.stage_timeout),
+        realtime: first.config.realtime.is_some(),
     };
     let node = local.node("host").map_err(|e| e.to_string())?;
     let control = msgs::open::control(&node, &local.run, &local.limits)

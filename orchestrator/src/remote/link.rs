@@ -8,6 +8,13 @@
 //! Every message goes out at once (`express`: not held back to be batched;
 //! lockstep waits for each one, so its latency is the run's pace).
 //!
+//! A real-time link ([`Flow::Freshest`]) is not lossless: like a network it
+//! carries what it can, newest first — no window, and the receiver keeps
+//! only its newest messages, so an age of information across hosts is the
+//! network's, not a window's. (Zenoh's congestion control stays `Block`:
+//! with `Drop` a quarter of the states on a 20 ms link were lost in Zenoh's
+//! own queue, and the ages were older.)
+//!
 //! Readiness: the receiver declares its subscriber, then acknowledges
 //! (count 0) every [`HELLO_EVERY`] until data flows; the sender sends nothing
 //! before its first acknowledgement, so no message is put before the other
@@ -16,7 +23,7 @@
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 use zenoh::Wait;
-use zenoh::handlers::{FifoChannel, FifoChannelHandler};
+use zenoh::handlers::{FifoChannel, FifoChannelHandler, RingChannel, RingChannelHandler};
 use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::Sample;
@@ -26,7 +33,7 @@ pub const HELLO_EVERY: Duration = Duration::from_millis(100);
 
 /// A link's window: at most `window` messages unacknowledged, acknowledged
 /// every `ack_every`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Window {
     /// Messages in flight at most.
     pub window: u64,
@@ -34,17 +41,45 @@ pub struct Window {
     pub ack_every: u64,
 }
 
-/// State links: as deep as a state subscriber's buffer (`msgs::Limits::state_buffer`).
-pub const STATE_WINDOW: Window = Window {
+/// What a link does with messages it cannot carry at once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Flow {
+    /// Lossless and ordered: the sender holds back beyond a window.
+    Window(Window),
+    /// Newest first (real time): no window, the receiver keeps its newest
+    /// `depth` messages.
+    Freshest {
+        /// Messages the receiver keeps, the oldest dropped first.
+        depth: usize,
+    },
+}
+
+/// State links in lockstep: as deep as a state subscriber's buffer
+/// (`msgs::Limits::state_buffer`).
+pub const STATE_WINDOW: Flow = Flow::Window(Window {
     window: 64,
     ack_every: 16,
-};
+});
+
+/// State links in real time (PROTOCOL § 7): as deep as a state
+/// subscriber's buffer, newest first.
+pub const STATE_FRESHEST: Flow = Flow::Freshest { depth: 64 };
 
 /// Telemetry links: as deep as the orchestrator's telemetry buffer.
-pub const TELEMETRY_WINDOW: Window = Window {
+pub const TELEMETRY_WINDOW: Flow = Flow::Window(Window {
     window: 256,
     ack_every: 64,
-};
+});
+
+impl Flow {
+    /// At most this many messages unacknowledged.
+    fn window(self) -> u64 {
+        match self {
+            Self::Window(w) => w.window,
+            Self::Freshest { .. } => u64::MAX,
+        }
+    }
+}
 
 /// A link failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -73,12 +108,12 @@ pub struct LinkSender {
     acked: Acked,
     _acks: Subscriber<()>,
     sent: u64,
-    window: Window,
+    flow: Flow,
 }
 
 impl LinkSender {
     /// Declares the publisher of `key` and the subscriber of its acks.
-    pub fn open(session: &zenoh::Session, key: &str, window: Window) -> Result<Self, LinkError> {
+    pub fn open(session: &zenoh::Session, key: &str, flow: Flow) -> Result<Self, LinkError> {
         let publisher = session
             .declare_publisher(key.to_string())
             .congestion_control(CongestionControl::Block)
@@ -106,7 +141,7 @@ impl LinkSender {
             acked,
             _acks: acks,
             sent: 0,
-            window,
+            flow,
         })
     }
 
@@ -125,7 +160,7 @@ impl LinkSender {
             .0
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        g.is_some_and(|a| self.sent - a < self.window.window)
+        g.is_some_and(|a| self.sent - a < self.flow.window())
     }
 
     /// Sends `bytes` now (call after [`Self::has_credit`]).
@@ -146,7 +181,7 @@ impl LinkSender {
         let deadline = Instant::now() + timeout;
         let (m, cv) = &*self.acked;
         let mut g = m.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        while g.is_none_or(|a| self.sent - a >= self.window.window) {
+        while g.is_none_or(|a| self.sent - a >= self.flow.window()) {
             if stop() {
                 return Err(LinkError::Stopped);
             }
@@ -165,25 +200,49 @@ impl LinkSender {
     }
 }
 
+/// A receiver's queue: a FIFO that holds a whole window (lossless), or a
+/// ring that drops its oldest (newest first).
+enum Inbox {
+    Fifo(Subscriber<FifoChannelHandler<Sample>>),
+    Ring(Subscriber<RingChannelHandler<Sample>>),
+}
+
+impl Inbox {
+    fn declare(session: &zenoh::Session, key: &str, flow: Flow) -> Result<Self, LinkError> {
+        let sub = session.declare_subscriber(key.to_string());
+        Ok(match flow {
+            Flow::Window(w) => {
+                let capacity = usize::try_from(w.window).unwrap_or(usize::MAX) + 16;
+                Self::Fifo(sub.with(FifoChannel::new(capacity)).wait().map_err(zerr)?)
+            }
+            Flow::Freshest { depth } => {
+                Self::Ring(sub.with(RingChannel::new(depth)).wait().map_err(zerr)?)
+            }
+        })
+    }
+
+    fn recv_timeout(&self, timeout: Duration) -> Result<Option<Sample>, LinkError> {
+        match self {
+            Self::Fifo(s) => s.recv_timeout(timeout).map_err(zerr),
+            Self::Ring(s) => s.recv_timeout(timeout).map_err(zerr),
+        }
+    }
+}
+
 /// The receiving end.
 pub struct LinkReceiver {
-    data: Subscriber<FifoChannelHandler<Sample>>,
+    data: Inbox,
     acks: Publisher<'static>,
     delivered: u64,
     last_ack: Instant,
-    window: Window,
+    flow: Flow,
 }
 
 impl LinkReceiver {
-    /// Declares the subscriber of `key` (its queue holds a whole window)
-    /// and the publisher of its acks, and says hello.
-    pub fn open(session: &zenoh::Session, key: &str, window: Window) -> Result<Self, LinkError> {
-        let capacity = usize::try_from(window.window).unwrap_or(usize::MAX) + 16;
-        let data = session
-            .declare_subscriber(key.to_string())
-            .with(FifoChannel::new(capacity))
-            .wait()
-            .map_err(zerr)?;
+    /// Declares the subscriber of `key` (its queue as `flow` says) and the
+    /// publisher of its acks, and says hello.
+    pub fn open(session: &zenoh::Session, key: &str, flow: Flow) -> Result<Self, LinkError> {
+        let data = Inbox::declare(session, key, flow)?;
         let acks = session
             .declare_publisher(super::keys::ack(key))
             .congestion_control(CongestionControl::Block)
@@ -195,7 +254,7 @@ impl LinkReceiver {
             acks,
             delivered: 0,
             last_ack: Instant::now(),
-            window,
+            flow,
         };
         r.ack()?;
         Ok(r)
@@ -211,7 +270,7 @@ impl LinkReceiver {
     /// The next message, waiting at most `timeout`; an idle receiver
     /// repeats its acknowledgement every [`HELLO_EVERY`].
     pub fn recv(&mut self, timeout: Duration) -> Result<Option<Vec<u8>>, LinkError> {
-        let got = self.data.recv_timeout(timeout).map_err(zerr)?;
+        let got = self.data.recv_timeout(timeout)?;
         if got.is_none() && self.last_ack.elapsed() >= HELLO_EVERY {
             self.last_ack = Instant::now();
             self.ack()?;
@@ -219,10 +278,14 @@ impl LinkReceiver {
         Ok(got.map(|s| s.payload().to_bytes().into_owned()))
     }
 
-    /// Books one message as delivered (acknowledged every `ack_every`).
+    /// Books one message as delivered (acknowledged every `ack_every` of
+    /// a window; a newest-first link needs no acknowledgement).
     pub fn delivered(&mut self) -> Result<(), LinkError> {
         self.delivered += 1;
-        if self.delivered % self.window.ack_every == 0 {
+        let Flow::Window(w) = self.flow else {
+            return Ok(());
+        };
+        if self.delivered % w.ack_every == 0 {
             self.last_ack = Instant::now();
             self.ack()?;
         }

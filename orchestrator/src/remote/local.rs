@@ -22,6 +22,9 @@ pub struct LocalNs {
     pub limits: Limits,
     /// The longest wait of one exchange (the stage timeout).
     pub stage_timeout: std::time::Duration,
+    /// The run is in real time (PROTOCOL § 7): its cut edges carry the
+    /// newest states first instead of every state.
+    pub realtime: bool,
 }
 
 impl LocalNs {
