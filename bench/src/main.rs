@@ -28,6 +28,8 @@
 //! - [`bare`]: one bare lockstep of `ring-node` processes; [`ring`]: one
 //!   `ring-node` process.
 //! - [`scale`]: `scale` — the in-process engine against N and threads.
+//! - [`hosts`]: `hosts` — one scenario on one machine and split over 2
+//!   and 3 hosts on loopback (daemons in mount namespaces of their own).
 //! - [`zping`]: `zenoh-ping` — Zenoh's own round trip on loopback, next to
 //!   plain TCP (the floor under the bridge across hosts).
 //! - [`procs`]: child processes with bounded waits; [`stats`]: medians, CPU
@@ -35,6 +37,7 @@
 
 mod bare;
 mod error;
+mod hosts;
 mod measure;
 mod procs;
 mod ring;
@@ -135,6 +138,23 @@ enum Cmd {
         /// Measurements per transport.
         #[arg(long, default_value_t = 3)]
         reps: usize,
+    },
+    /// A scenario on one machine and split over 2 and 3 `attsync host`
+    /// daemons on loopback, each in a mount namespace of its own (root),
+    /// repetitions interleaved (a Markdown table).
+    Hosts {
+        /// The scenario (default: the paper's time-varying run).
+        #[arg(long)]
+        scenario: Option<PathBuf>,
+        /// Simulated seconds.
+        #[arg(long, default_value_t = 40.0)]
+        duration: f64,
+        /// Repetitions of every placement.
+        #[arg(long, default_value_t = 3)]
+        reps: usize,
+        /// Machine counts, comma-separated (1: the orchestrator's alone).
+        #[arg(long, value_delimiter = ',', default_value = "1,2,3")]
+        machines: Vec<usize>,
     },
     /// (internal) The echoing end of `zenoh-ping`.
     ZenohPong {
@@ -238,6 +258,12 @@ fn main() -> ExitCode {
 fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
     match cmd {
         Cmd::Burn => suite::burn(),
+        Cmd::Hosts {
+            scenario,
+            duration,
+            reps,
+            machines,
+        } => hosts_table(scenario, duration, reps, machines),
         Cmd::ZenohPong { connect, transport } => zping::pong(&connect, transport),
         Cmd::ZenohPing {
             payload,
@@ -318,6 +344,50 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             run(opts, out)
         }
     }
+}
+
+/// `attsync-bench hosts`: measures, then prints the table.
+fn hosts_table(
+    scenario: Option<PathBuf>,
+    duration: f64,
+    reps: usize,
+    machines: Vec<usize>,
+) -> anyhow::Result<()> {
+    let bench = std::env::current_exe().context("own path")?;
+    let dir = bench.parent().map(PathBuf::from).unwrap_or_default();
+    let scenario = scenario.unwrap_or_else(|| {
+        let local = PathBuf::from("scenarios/paper/timevarying.toml");
+        if local.is_file() {
+            local
+        } else {
+            PathBuf::from(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../scenarios/paper/timevarying.toml"
+            ))
+        }
+    });
+    let work = std::env::temp_dir().join(format!("attsync-bench-hosts-{}", std::process::id()));
+    let o = hosts::Options {
+        scenario,
+        duration,
+        reps,
+        machines,
+        work: work.clone(),
+    };
+    let bins = measure::Bins {
+        attsync: dir.join("attsync"),
+        bench,
+    };
+    println!(
+        "machine: {}; load average before: {}",
+        stats::machine(),
+        stats::loadavg()
+    );
+    let placed = hosts::measure(&o, &bins);
+    let _ = std::fs::remove_dir_all(&work);
+    print!("{}", hosts::table(&placed?));
+    println!("load average after: {}", stats::loadavg());
+    Ok(())
 }
 
 /// `attsync-bench zenoh-ping`: `reps` measurements per transport,

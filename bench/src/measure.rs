@@ -71,6 +71,19 @@ pub fn attsync(
     out: &Path,
     timeout: Duration,
 ) -> Result<AttsyncRun> {
+    attsync_with(bins, scenario, engine, sets, &[], out, timeout)
+}
+
+/// [`attsync`] with `extra` arguments (`--hosts FILE`).
+pub fn attsync_with(
+    bins: &Bins,
+    scenario: &Path,
+    engine: Engine,
+    sets: &[String],
+    extra: &[std::ffi::OsString],
+    out: &Path,
+    timeout: Duration,
+) -> Result<AttsyncRun> {
     let _ = std::fs::remove_dir_all(out);
     let parent = out.parent().unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).map_err(BenchError::io(parent))?;
@@ -82,7 +95,7 @@ pub fn attsync(
         Engine::InProcess => cmd.args(["--engine", "in-process"]),
         Engine::Processes(w) => cmd.args(["--engine", "processes", "--wait", wait_name(w)]),
     };
-    cmd.arg("--out").arg(out).arg("--quiet");
+    cmd.arg("--out").arg(out).arg("--quiet").args(extra);
     for s in sets {
         cmd.arg("--set").arg(s);
     }
