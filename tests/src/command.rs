@@ -9,6 +9,17 @@ use std::ffi::{OsStr, OsString};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
+/// Runs `scenario` (with `sets`) on the in-process engine into `out`, in
+/// `cwd`, and asserts it succeeded: the reference that a run of the
+/// process engine or over hosts is compared with.
+#[track_caller]
+pub fn reference_run(cwd: &Path, scenario: &Path, out: &Path, sets: &[&str]) {
+    Attsync::new(cwd)
+        .args(run_args(scenario, "in-process", out, sets))
+        .output()
+        .assert_ok();
+}
+
 /// The arguments of `attsync run SCENARIO --engine ENGINE --out OUT --quiet
 /// --set S…`.
 #[must_use]

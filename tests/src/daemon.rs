@@ -154,6 +154,27 @@ pub fn run_on_hosts(
         .args(["--hosts".as_ref(), hosts.as_os_str()])
 }
 
+/// Runs the paper's time-varying run (1 s simulated) over `hosts` into
+/// `tmp/again` and asserts that it completes and that `daemons` keep
+/// nothing of it: after a failure, the daemons serve the next run.
+#[track_caller]
+pub fn assert_serves_again(tmp: &crate::Sandbox, hosts: &Path, daemons: &[&Daemon]) {
+    let again = tmp.join("again");
+    let scenario = crate::paper("timevarying");
+    run_on_hosts(
+        tmp.path(),
+        &scenario,
+        &again,
+        &["simulation.duration=1"],
+        hosts,
+    )
+    .output()
+    .assert_ok()
+    .assert_no_leftovers();
+    assert_eq!(crate::summary(&again)["complete"], true);
+    assert_hosts_clean(daemons);
+}
+
 /// Asserts no daemon of `daemons` kept anything of its runs ([`Daemon::leftovers`]).
 #[track_caller]
 pub fn assert_hosts_clean(daemons: &[&Daemon]) {

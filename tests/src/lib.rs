@@ -13,7 +13,8 @@
 //! - `sandbox.rs`: [`Sandbox`], a temporary directory per test, kept (and its
 //!   path printed) if the test fails.
 //! - `command.rs`: [`Attsync`], an `attsync` command line ([`run_args`] builds
-//!   the usual `run` arguments).
+//!   the usual `run` arguments; [`reference_run`]: the in-process run that
+//!   others are compared with).
 //! - `running.rs`: [`Running`], a started `attsync`, waited for with a bound
 //!   ([`Running::wait`]; [`Running::once_stepping`]: until a node steps)
 //!   and killed together with its node processes if the
@@ -40,7 +41,8 @@
 //! - `conform.rs`: [`run_conform`] (`attsync conform` of a candidate),
 //!   [`rule_line`] (one rule's verdict in its report).
 //! - `daemon.rs`: [`Daemon`], an `attsync host` in a [`HostSandbox`] of its own;
-//!   [`hosts_file`] (a HOSTS.toml of daemons), [`run_on_hosts`], [`assert_hosts_clean`].
+//!   [`hosts_file`] (a HOSTS.toml of daemons), [`run_on_hosts`], [`assert_hosts_clean`],
+//!   [`assert_serves_again`] (the daemons serve the next run, clean).
 //! - `python.rs`: [`require_iceoryx2_module`], [`conform_python`] (agents
 //!   written in Python).
 //! - `variant.rs`: scenario files edited for a test: [`with_agent_lines`]
@@ -65,9 +67,9 @@ mod sandbox;
 mod variant;
 mod workspace;
 
-pub use command::{Attsync, run_args};
+pub use command::{Attsync, reference_run, run_args};
 pub use conform::{rule_line, run_conform};
-pub use daemon::{Daemon, assert_hosts_clean, hosts_file, run_on_hosts};
+pub use daemon::{Daemon, assert_hosts_clean, assert_serves_again, hosts_file, run_on_hosts};
 pub use delay_relay::DelayRelay;
 pub use delayed_host::{DAEMON_PORT, DelayKind, DelayedHost};
 pub use hosts::{HostProcess, HostSandbox, free_port};

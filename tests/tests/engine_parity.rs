@@ -15,7 +15,9 @@
 //! Covered: the three paper scenarios (2 s each), sampled coupling, every
 //! `--wait` strategy, and two processes runs in a row (determinism).
 
-use attsync_tests::{Attsync, Sandbox, assert_same_results, paper, read, run_args, summary};
+use attsync_tests::{
+    Attsync, Sandbox, assert_same_results, paper, read, reference_run, run_args, summary,
+};
 use std::path::Path;
 
 const TWO_SECONDS: &str = "simulation.duration=2";
@@ -31,10 +33,7 @@ fn parity(test: &str, scenario: &Path, sets: &[&str], extra: &[&str]) -> Sandbox
         .output()
         .assert_ok()
         .assert_no_leftovers();
-    Attsync::new(tmp.path())
-        .args(run_args(scenario, "in-process", &i, sets))
-        .output()
-        .assert_ok();
+    reference_run(tmp.path(), scenario, &i, sets);
     assert_same_results(&p, &i);
     let s = summary(&p);
     assert_eq!(s["engine"], "processes");

@@ -9,8 +9,8 @@
 //!   with exit 0.
 
 use attsync_tests::{
-    Attsync, Daemon, Sandbox, assert_hosts_clean, free_port, hosts_file, paper, run_on_hosts,
-    staging_dir, summary,
+    Attsync, Daemon, Sandbox, assert_hosts_clean, assert_serves_again, free_port, hosts_file,
+    paper, run_on_hosts, staging_dir, summary,
 };
 use std::time::{Duration, Instant};
 
@@ -61,19 +61,7 @@ fn a_daemon_killed_mid_run_fails_the_run_naming_it_and_a_restarted_one_serves_ag
     assert_hosts_clean(&[&a]);
     // The same daemon, started again, serves the next run.
     b.restart();
-    let again = tmp.join("again");
-    run_on_hosts(
-        tmp.path(),
-        &paper("timevarying"),
-        &again,
-        &["simulation.duration=1"],
-        &hosts,
-    )
-    .output()
-    .assert_ok()
-    .assert_no_leftovers();
-    assert_eq!(summary(&again)["complete"], true);
-    assert_hosts_clean(&[&a, &b]);
+    assert_serves_again(&tmp, &hosts, &[&a, &b]);
 }
 
 #[test]

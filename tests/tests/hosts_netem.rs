@@ -17,8 +17,8 @@
 //! Nothing is left on the host, and no veth pair once it is dropped.
 
 use attsync_tests::{
-    Attsync, DelayKind, DelayedHost, Sandbox, assert_hosts_clean, assert_same_results, hosts_file,
-    link_exists, paper, run_args, run_on_hosts, summary,
+    DelayKind, DelayedHost, Sandbox, assert_hosts_clean, assert_same_results, hosts_file,
+    link_exists, paper, reference_run, run_on_hosts, summary,
 };
 use serde_json::Value;
 use std::time::Duration;
@@ -113,10 +113,7 @@ fn lockstep_with_the_delay_simulated_is_byte_identical_despite_the_real_one() {
         .output()
         .assert_ok()
         .assert_no_leftovers();
-    Attsync::new(tmp.path())
-        .args(run_args(&paper("timevarying"), "in-process", &i, &sets))
-        .output()
-        .assert_ok();
+    reference_run(tmp.path(), &paper("timevarying"), &i, &sets);
     assert_same_results(&p, &i);
     let s = summary(&p);
     assert_eq!(s["complete"], true, "{s:#}");

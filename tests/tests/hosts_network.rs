@@ -4,8 +4,8 @@
 //! byte-identical to the in-process engine, nothing left on any host.
 
 use attsync_tests::{
-    Attsync, Daemon, Sandbox, assert_hosts_clean, assert_same_results, hosts_file, paper, run_args,
-    run_on_hosts,
+    Attsync, Daemon, Sandbox, assert_hosts_clean, assert_same_results, hosts_file, paper,
+    reference_run, run_on_hosts,
 };
 use std::path::Path;
 
@@ -17,10 +17,7 @@ fn parity(tmp: &Sandbox, scenario: &Path, sets: &[&str], hosts: &Path) {
         .output()
         .assert_ok()
         .assert_no_leftovers();
-    Attsync::new(tmp.path())
-        .args(run_args(scenario, "in-process", &i, sets))
-        .output()
-        .assert_ok();
+    reference_run(tmp.path(), scenario, &i, sets);
     assert_same_results(&p, &i);
 }
 

@@ -14,9 +14,9 @@
 //! Nothing is left on any host afterwards.
 
 use attsync_tests::{
-    Attsync, Daemon, Running, Sandbox, assert_hosts_clean, assert_same_bytes, bin, hosts_file,
-    kill9, owned_run, paper, read, run_args, run_leftovers, run_on_hosts, run_processes, scenario,
-    sh_plugin, staging_dir, summary, wait_until, with_agent_lines,
+    Attsync, Daemon, Running, Sandbox, assert_hosts_clean, assert_same_bytes, assert_serves_again,
+    bin, hosts_file, kill9, owned_run, paper, read, run_args, run_leftovers, run_on_hosts,
+    run_processes, scenario, sh_plugin, staging_dir, summary, wait_until, with_agent_lines,
 };
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -223,19 +223,7 @@ fn losing_the_orchestrator_makes_each_daemon_clean_its_run_up_and_serve_the_next
     }
     let _ = std::fs::remove_dir_all(&staging);
     // The same daemons serve the next run.
-    let again = tmp.join("again");
-    run_on_hosts(
-        tmp.path(),
-        &paper("timevarying"),
-        &again,
-        &["simulation.duration=1"],
-        &hosts,
-    )
-    .output()
-    .assert_ok()
-    .assert_no_leftovers();
-    assert_eq!(summary(&again)["complete"], true);
-    assert_hosts_clean(&[&a, &b]);
+    assert_serves_again(&tmp, &hosts, &[&a, &b]);
 }
 
 /// The bytes a chatty plug-in prints before it runs the agent (far more

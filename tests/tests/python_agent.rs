@@ -10,7 +10,7 @@
 //! README's test command and `.ci/run` do it).
 
 use attsync_tests::{
-    Attsync, Sandbox, assert_same_bytes, assert_same_file, conform_python, paper,
+    Attsync, Sandbox, assert_same_bytes, assert_same_file, conform_python, paper, reference_run,
     require_iceoryx2_module, run_args, scenario, summary,
 };
 use std::path::PathBuf;
@@ -123,10 +123,7 @@ fn bit_identical_to_builtin(plugin: &str, builtin: &str, sets: &[&str]) {
         .output()
         .assert_ok()
         .assert_no_leftovers();
-    Attsync::new(tmp.path())
-        .args(run_args(&paper(builtin), "in-process", &reference, sets))
-        .output()
-        .assert_ok();
+    reference_run(tmp.path(), &paper(builtin), &reference, sets);
     let s = summary(&py);
     assert_eq!(s["complete"], true, "{s:#}");
     assert!(

@@ -7,7 +7,8 @@
 //! no iceoryx2 files are left.
 
 use attsync_tests::{
-    Attsync, Sandbox, assert_same_results, csv_agents, csv_rows, read, run_args, summary,
+    Attsync, Sandbox, assert_same_results, csv_agents, csv_rows, read, reference_run, run_args,
+    summary,
 };
 use std::fmt::Write as _;
 use std::path::Path;
@@ -75,10 +76,7 @@ fn both_engines(tmp: &Sandbox, scenario: &Path, agents: u32) {
         .output()
         .assert_ok()
         .assert_no_leftovers();
-    Attsync::new(tmp.path())
-        .args(run_args(scenario, "in-process", &i, &[]))
-        .output()
-        .assert_ok();
+    reference_run(tmp.path(), scenario, &i, &[]);
     let csv = read(&p.join("errors.csv"));
     assert_eq!(csv_agents(&csv), (1..=agents).collect());
     assert_eq!(csv_rows(&csv), 21 * agents as usize);

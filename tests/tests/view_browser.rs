@@ -8,7 +8,7 @@
 //! request: the page is made to fetch a URL, and its Content-Security-Policy
 //! must refuse it with an error the checker sees.
 
-use attsync_tests::{Attsync, Sandbox, paper, run_args};
+use attsync_tests::{Sandbox, paper, reference_run};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -27,10 +27,7 @@ fn the_view_opens_offline_in_headless_chromium_and_moves() {
     let tmp = Sandbox::new("view_browser");
     let out = tmp.join("tv");
     let sets = ["simulation.duration=21"];
-    Attsync::new(tmp.path())
-        .args(run_args(&paper("timevarying"), "in-process", &out, &sets))
-        .output()
-        .assert_ok();
+    reference_run(tmp.path(), &paper("timevarying"), &out, &sets);
     let html = out.join("view.html");
     assert!(html.is_file(), "the run wrote no view.html");
     let check = Command::new("python3")
