@@ -74,7 +74,7 @@ pub fn attsync(
     attsync_with(bins, scenario, engine, sets, &[], out, timeout)
 }
 
-/// [`attsync`] with `extra` arguments (`--hosts FILE`).
+/// [`attsync()`] with `extra` arguments (`--hosts FILE`).
 pub fn attsync_with(
     bins: &Bins,
     scenario: &Path,
