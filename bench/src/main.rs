@@ -346,6 +346,19 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
     }
 }
 
+/// `rel` in the current directory if it is there, else in the repository
+/// this program was built from.
+fn in_repository(rel: &str) -> PathBuf {
+    let local = PathBuf::from(rel);
+    if local.exists() {
+        local
+    } else {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("..")
+            .join(rel)
+    }
+}
+
 /// `attsync-bench hosts`: measures, then prints the table.
 fn hosts_table(
     scenario: Option<PathBuf>,
@@ -355,17 +368,7 @@ fn hosts_table(
 ) -> anyhow::Result<()> {
     let bench = std::env::current_exe().context("own path")?;
     let dir = bench.parent().map(PathBuf::from).unwrap_or_default();
-    let scenario = scenario.unwrap_or_else(|| {
-        let local = PathBuf::from("scenarios/paper/timevarying.toml");
-        if local.is_file() {
-            local
-        } else {
-            PathBuf::from(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../scenarios/paper/timevarying.toml"
-            ))
-        }
-    });
+    let scenario = scenario.unwrap_or_else(|| in_repository("scenarios/paper/timevarying.toml"));
     let work = std::env::temp_dir().join(format!("attsync-bench-hosts-{}", std::process::id()));
     let o = hosts::Options {
         scenario,
@@ -498,14 +501,9 @@ fn run(a: RunArgs, out: Option<PathBuf>) -> anyhow::Result<()> {
             );
         }
     }
-    let scenarios = a.scenarios.unwrap_or_else(|| {
-        let local = PathBuf::from("scenarios/paper");
-        if local.is_dir() {
-            local
-        } else {
-            PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/paper"))
-        }
-    });
+    let scenarios = a
+        .scenarios
+        .unwrap_or_else(|| in_repository("scenarios/paper"));
     let (work, temporary) = match a.work {
         Some(w) => (w, false),
         None => (

@@ -85,6 +85,18 @@ fn open(c: zenoh::Config) -> anyhow::Result<zenoh::Session> {
         .map_err(|e| anyhow::anyhow!("zenoh: {e}"))
 }
 
+/// A publisher of `key` as the bridge declares its links' (`Block`, `express`).
+fn publisher(
+    s: &zenoh::Session,
+    key: &'static str,
+) -> anyhow::Result<zenoh::pubsub::Publisher<'static>> {
+    s.declare_publisher(key)
+        .congestion_control(CongestionControl::Block)
+        .express(true)
+        .wait()
+        .map_err(|e| anyhow::anyhow!("{e}"))
+}
+
 /// The pong: echoes every ping until the ping's session goes (or 120 s).
 pub fn pong(connect: &str, transport: Transport) -> anyhow::Result<()> {
     if transport == Transport::Tcp {
@@ -92,12 +104,7 @@ pub fn pong(connect: &str, transport: Transport) -> anyhow::Result<()> {
     }
     let lowlatency = transport == Transport::Lowlatency;
     let s = open(config(&[], &[connect.to_string()], lowlatency)?)?;
-    let publisher = s
-        .declare_publisher(PONG)
-        .congestion_control(CongestionControl::Block)
-        .express(true)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let publisher = publisher(&s, PONG)?;
     let (done_tx, done_rx) = std::sync::mpsc::channel::<()>();
     let _sub = s
         .declare_subscriber(PING)
@@ -194,12 +201,7 @@ pub fn ping(p: Ping) -> anyhow::Result<Vec<f64>> {
         .with(zenoh::handlers::FifoChannel::new(64))
         .wait()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let publisher = s
-        .declare_publisher(PING)
-        .congestion_control(CongestionControl::Block)
-        .express(true)
-        .wait()
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let publisher = publisher(&s, PING)?;
     let child = spawn_pong(&endpoint, p.transport)?;
     let result = rounds(&publisher, &replies, p);
     let _ = publisher.put(Vec::<u8>::new()).wait();

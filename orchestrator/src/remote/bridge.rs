@@ -11,7 +11,7 @@
 
 use super::Side;
 use super::keys;
-use super::link::{Flow, LinkReceiver, LinkSender, STATE_FRESHEST, STATE_WINDOW};
+use super::link::{Flow, LinkReceiver, LinkSender, STATE_DEPTH, STATE_FRESHEST, STATE_WINDOW};
 use super::local::{LocalNs, Shared};
 use super::wire::StateLink;
 use iceoryx2::port::update_connections::UpdateConnections;
@@ -130,9 +130,8 @@ impl Outgoing {
     }
 }
 
-/// The states a link's sending end reads ahead of its window (a state
-/// subscriber's buffer).
-const QUEUE: usize = 64;
+/// The states a link's sending end reads ahead of its window.
+const QUEUE: usize = STATE_DEPTH;
 
 /// How `ns`'s cut edges carry states: every one in lockstep, the newest
 /// first in real time.

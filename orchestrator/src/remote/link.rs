@@ -54,16 +54,18 @@ pub enum Flow {
     },
 }
 
-/// State links in lockstep: as deep as a state subscriber's buffer
+/// A state link's depth, in messages: a state subscriber's buffer
 /// (`msgs::Limits::state_buffer`).
+pub const STATE_DEPTH: usize = 64;
+
+/// State links in lockstep: [`STATE_DEPTH`] in flight.
 pub const STATE_WINDOW: Flow = Flow::Window(Window {
-    window: 64,
+    window: STATE_DEPTH as u64,
     ack_every: 16,
 });
 
-/// State links in real time (PROTOCOL § 7): as deep as a state
-/// subscriber's buffer, newest first.
-pub const STATE_FRESHEST: Flow = Flow::Freshest { depth: 64 };
+/// State links in real time (PROTOCOL § 7): [`STATE_DEPTH`], newest first.
+pub const STATE_FRESHEST: Flow = Flow::Freshest { depth: STATE_DEPTH };
 
 /// Telemetry links: as deep as the orchestrator's telemetry buffer.
 pub const TELEMETRY_WINDOW: Flow = Flow::Window(Window {
