@@ -62,7 +62,7 @@ pub fn psi(a: &Matrix3<f64>) -> Vector3<f64> {
 /// Uses Taylor series for θ < 1e-4 so the result stays orthogonal to
 /// machine precision for tiny increments (the integrator's common case).
 #[must_use]
-#[inline]
+#[inline(always)]
 pub fn exp(u: &Vector3<f64>) -> Matrix3<f64> {
     let t2 = u.norm_squared();
     let (a, b) = if t2 < 1e-8 {
@@ -132,7 +132,7 @@ pub fn abs_i(r: &Matrix3<f64>) -> f64 {
 /// coefficient is `1/12 + θ²/720 + θ⁴/30240`. `PROTOCOL.md` § 10.2 gives
 /// the order of every operation.
 #[must_use]
-#[inline]
+#[inline(always)]
 pub fn dexp_inv(u: &Vector3<f64>, w: &Vector3<f64>) -> Vector3<f64> {
     let t2 = u.norm_squared();
     let c = if t2 < 1e-6 {

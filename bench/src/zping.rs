@@ -8,11 +8,13 @@
 //! scouting off) and the publishers as the bridge declares them
 //! (congestion control `Block`, `express`). The pong echoes each sample from
 //! its subscriber callback (no thread hop: Zenoh alone); the ping receives
-//! through a FIFO channel on its own thread, as the bridge does. With
-//! [`Transport::Lowlatency`] both use Zenoh's low-latency transport (QoS
-//! off), which writes to the socket from the calling thread instead of a TX
-//! task. [`Transport::Tcp`] is the floor: the same payload echoed over a
-//! plain blocking TCP socket (`TCP_NODELAY`), no Zenoh at all.
+//! through a FIFO channel on its own thread, as the bridge does.
+//! attsync's configuration ([`Transport::Lowlatency`]) uses Zenoh's
+//! low-latency transport (QoS off), which writes to the socket from the
+//! calling thread; [`Transport::Default`] switches it back to Zenoh's
+//! default transport (a TX task, QoS on). [`Transport::Tcp`] is the floor:
+//! the same payload echoed over a plain blocking TCP socket
+//! (`TCP_NODELAY`), no Zenoh at all.
 
 use anyhow::{Context as _, bail};
 use std::io::{Read as _, Write as _};
@@ -30,9 +32,9 @@ const PONG: &str = "attsync-bench/pong";
 pub enum Transport {
     /// A plain blocking TCP socket: the floor.
     Tcp,
-    /// Zenoh as attsync configures it.
+    /// Zenoh's default transport (a TX task, QoS on).
     Default,
-    /// Zenoh with `transport/unicast/lowlatency` (QoS off).
+    /// Zenoh as attsync configures it: `transport/unicast/lowlatency` (QoS off).
     Lowlatency,
 }
 
@@ -67,10 +69,10 @@ fn config(
     lowlatency: bool,
 ) -> anyhow::Result<zenoh::Config> {
     let mut c = attsync::remote::zconfig::peer(listen, connect)?;
-    if lowlatency {
+    if !lowlatency {
         for (k, v) in [
-            ("transport/unicast/lowlatency", "true"),
-            ("transport/unicast/qos/enabled", "false"),
+            ("transport/unicast/lowlatency", "false"),
+            ("transport/unicast/qos/enabled", "true"),
         ] {
             c.insert_json5(k, v)
                 .map_err(|e| anyhow::anyhow!("{k}: {e}"))?;

@@ -1,7 +1,8 @@
 //! Across hosts, beyond the paper's runs (issue 12): `[network]`
 //! impairments (simulated on the receiving side, so unchanged across
-//! hosts) and a generated 30-agent tree over three hosts, each
-//! byte-identical to the in-process engine, nothing left on any host.
+//! hosts), a generated 30-agent tree over three hosts, and a host whose
+//! run request is larger than one Zenoh batch, each byte-identical to the
+//! in-process engine, nothing left on any host.
 
 use attsync_tests::{
     Attsync, Daemon, Sandbox, assert_hosts_clean, assert_same_results, hosts_file, paper,
@@ -75,4 +76,26 @@ fn a_thirty_agent_tree_over_three_hosts_is_byte_identical() {
     );
     parity(&tmp, &tree, &[], &hosts);
     assert_hosts_clean(&[&a, &b, &c]);
+}
+
+/// 60 agents on one host: their configurations make a run request of
+/// ~86 KB (measured: `ATTSYNC_LOG=attsync=debug` logs it), more than the
+/// 64 KiB that Zenoh's low-latency transport carries in one message, so it
+/// travels in pieces (`orchestrator/src/remote/pieces.rs`); their end
+/// reply (60 log tails) too.
+#[test]
+fn a_run_request_larger_than_a_zenoh_batch_arrives_whole() {
+    let tmp = Sandbox::new("hosts-big-request");
+    let tree = tmp.join("tree.toml");
+    Attsync::new(tmp.path())
+        .args(["gen", "tree", "--agents", "60", "--seed", "3"])
+        .args(["--scheme", "observerless", "--duration", "1", "--out"])
+        .args([&tree])
+        .output()
+        .assert_ok();
+    let a = Daemon::start("a", &[]);
+    let all: Vec<u32> = (1..=60).collect();
+    let hosts = hosts_file(tmp.path(), "hosts.toml", &[(&a, false, &all)]);
+    parity(&tmp, &tree, &["simulation.duration=0.1"], &hosts);
+    assert_hosts_clean(&[&a]);
 }

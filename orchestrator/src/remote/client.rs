@@ -9,9 +9,12 @@ use super::Side;
 use super::bridge::Bridges;
 use super::keys;
 use super::local::{LocalNs, Shared};
+use super::pieces;
 use super::plan::{Plan, links};
 use super::telemetry::{self, End, TelemetryThread};
-use super::wire::{Answer, EndReply, EndRequest, HostEvent, NodeEnd, RemoteNode, RunRequest};
+use super::wire::{
+    Answer, EndReply, EndRequest, HostEvent, NodeEnd, RemoteNode, RunOffer, RunRequest,
+};
 use super::zconfig;
 use crate::processes::node_log::cut_note;
 use msgs::ControlMsg;
@@ -213,23 +216,34 @@ impl Remote {
                     .cloned()
                     .collect(),
             };
+            // The host fetches the request (in pieces) before it answers.
             let body = serde_json::to_vec(&req).expect("serialises");
+            tracing::debug!(host = %h.name, bytes = body.len(), "run request");
+            let served = (s.declare_queryable(keys::request(run, &h.name)))
+                .callback(move |q| pieces::reply(&q, &body))
+                .wait()
+                .map_err(zerr)?;
+            let offer = RunOffer {
+                run: self.run.clone(),
+                host: h.name.clone(),
+            };
             let replies = (s.get(keys::run(&h.name)))
-                .payload(body)
+                .payload(serde_json::to_vec(&offer).expect("serialises"))
                 .consolidation(ConsolidationMode::None)
                 .timeout(ANSWER_TIMEOUT)
                 .wait()
                 .map_err(zerr)?;
-            pending.push((h.name.clone(), replies));
+            pending.push((h.name.clone(), replies, served));
         }
-        for (name, replies) in pending {
-            let answer: Answer = match replies.recv() {
-                Ok(r) => match r.result() {
-                    Ok(s) => serde_json::from_slice(&s.payload().to_bytes())
-                        .unwrap_or_else(|e| Err(format!("a bad answer: {e}"))),
-                    Err(e) => Err(String::from_utf8_lossy(&e.payload().to_bytes()).into_owned()),
-                },
-                Err(_) => Err(format!("no answer within {} s", ANSWER_TIMEOUT.as_secs())),
+        for (name, replies, _served) in pending {
+            let answer: Answer = match pieces::collect(&replies) {
+                Ok(b) => {
+                    serde_json::from_slice(&b).unwrap_or_else(|e| Err(format!("a bad answer: {e}")))
+                }
+                Err(pieces::CollectError::NoAnswer) => {
+                    Err(format!("no answer within {} s", ANSWER_TIMEOUT.as_secs()))
+                }
+                Err(e) => Err(e.to_string()),
             };
             answer.map_err(|e| format!("host {name} could not start its nodes: {e}"))?;
             self.started.push(name);
@@ -323,10 +337,8 @@ impl Remote {
             }
         }
         for (name, replies) in pending {
-            let reply: Option<EndReply> = replies
-                .recv()
+            let reply: Option<EndReply> = pieces::collect(&replies)
                 .ok()
-                .and_then(|r| r.result().ok().map(|s| s.payload().to_bytes().into_owned()))
                 .and_then(|b| serde_json::from_slice(&b).ok());
             let Some(reply) = reply else {
                 bad.push(RemoteExit {

@@ -6,7 +6,7 @@
 
 use super::host_run::{self, Command};
 use super::keys;
-use super::wire::{EndRequest, RunRequest};
+use super::wire::{EndRequest, RunOffer};
 use super::zconfig::{self, ConfigError};
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -145,14 +145,15 @@ fn payload<T: serde::de::DeserializeOwned>(q: &Query) -> Result<T, String> {
     serde_json::from_slice(&b).map_err(|e| format!("a bad request: {e}"))
 }
 
-/// Starts the run of request `q` on its own thread.
+/// Starts the run offered by `q` on its own thread, which fetches the
+/// run's request ([`host_run::serve_offer`]).
 fn accept(
     session: &zenoh::Session,
     name: &str,
     q: Query,
     runs: &mut HashMap<String, (Sender<Command>, JoinHandle<()>)>,
 ) {
-    let req: RunRequest = match payload(&q) {
+    let req: RunOffer = match payload(&q) {
         Ok(r) => r,
         Err(e) => return host_run::answer(&q, &Err(e)),
     };
@@ -167,7 +168,7 @@ fn accept(
     let (tx, rx) = mpsc::channel();
     let s = session.clone();
     let run = req.run.clone();
-    let t = std::thread::spawn(move || host_run::serve(s, req, q, rx));
+    let t = std::thread::spawn(move || host_run::serve_offer(s, req, q, rx));
     runs.insert(run, (tx, t));
 }
 

@@ -9,8 +9,9 @@ use super::Side;
 use super::bridge::Bridges;
 use super::keys;
 use super::local::{LocalNs, Shared};
+use super::pieces;
 use super::telemetry::{self, End, TelemetryThread};
-use super::wire::{EndReply, EndRequest, HostEvent, NodeEnd, RunRequest};
+use super::wire::{EndReply, EndRequest, HostEvent, NodeEnd, RunOffer, RunRequest};
 use crate::processes::namespace::Namespace;
 use crate::processes::node_log::last_bytes;
 use crate::processes::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
@@ -128,6 +129,45 @@ fn start(
     Ok((r, nodes))
 }
 
+/// Longest wait for the orchestrator to hand over a run's request.
+const FETCH_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Fetches the request of the run `offer` offers (from the orchestrator's
+/// `attsync/<run>/request/<host>`, in pieces), then [`serve`]s it.
+pub fn serve_offer(
+    session: zenoh::Session,
+    offer: RunOffer,
+    reply: Query,
+    commands: Receiver<Command>,
+) {
+    match fetch(&session, &offer) {
+        Ok(req) => serve(session, req, reply, commands),
+        Err(e) => {
+            tracing::warn!(run = %offer.run, "cannot fetch the run's request: {e}");
+            answer(&reply, &Err(e));
+        }
+    }
+}
+
+/// The request of the run `offer` offers.
+fn fetch(session: &zenoh::Session, offer: &RunOffer) -> Result<RunRequest, String> {
+    let replies = (session.get(super::keys::request(&offer.run, &offer.host)))
+        .consolidation(zenoh::query::ConsolidationMode::None)
+        .timeout(FETCH_TIMEOUT)
+        .wait()
+        .map_err(|e| format!("zenoh: {e}"))?;
+    let bytes = pieces::collect(&replies).map_err(|e| format!("its request: {e}"))?;
+    let req: RunRequest =
+        serde_json::from_slice(&bytes).map_err(|e| format!("a bad request: {e}"))?;
+    if (req.run.as_str(), req.host.as_str()) != (offer.run.as_str(), offer.host.as_str()) {
+        return Err(format!(
+            "the request of run {} for {} came for run {} on {}",
+            offer.run, offer.host, req.run, req.host
+        ));
+    }
+    Ok(req)
+}
+
 /// Serves run `req` until it ends; `reply` gets the answer to the run request.
 pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: Receiver<Command>) {
     let shared = Shared::default();
@@ -234,7 +274,7 @@ fn watch(
                 id: *id,
                 status: describe(&e.status),
                 clean: matches!(&e.status, Ok(s) if s.success()),
-                tail: tail(log, 10),
+                tail: bounded(tail(log, 10)),
             });
             let k = e.index;
             exits[k] = Some(e);
@@ -246,7 +286,7 @@ fn watch(
         }
         if let (Some(f), false) = (shared.failure(), failed_said) {
             failed_said = true;
-            ports.put(&HostEvent::Failed(f));
+            ports.put(&HostEvent::Failed(bounded(f)));
         }
         let gone = ports.lost.load(Ordering::Relaxed)
             || (!ports.alive.load(Ordering::Relaxed) && began.elapsed() > ORCHESTRATOR_GRACE);
@@ -293,6 +333,23 @@ fn wind_down(
     (logs, leftovers)
 }
 
+/// Longest text of an event, bytes: JSON escapes it to at most 6× that,
+/// far under one Zenoh batch (events are puts, not sent in [`pieces`]).
+const EVENT_TEXT: usize = 8 << 10;
+
+/// `s`, or its last [`EVENT_TEXT`] bytes (from a character's start) after
+/// a mark saying it was cut.
+fn bounded(s: String) -> String {
+    if s.len() <= EVENT_TEXT {
+        return s;
+    }
+    let mut start = s.len() - EVENT_TEXT;
+    while !s.is_char_boundary(start) {
+        start += 1;
+    }
+    format!("[…] {}", &s[start..])
+}
+
 /// The answer to the orchestrator's end request: each node's exit and the
 /// end of its log (bounded: [`last_bytes`]).
 fn reply_end(
@@ -316,20 +373,28 @@ fn reply_end(
             .collect(),
         leftovers,
     };
-    let _ = q
-        .reply(
-            q.key_expr().clone(),
-            serde_json::to_vec(&reply).expect("serialises"),
-        )
-        .wait();
+    pieces::reply(q, &serde_json::to_vec(&reply).expect("serialises"));
 }
 
-/// Replies `a` to query `q`.
+/// Replies `a` to query `q` (in pieces, like every reply but a ping's).
 pub fn answer(q: &Query, a: &super::wire::Answer) {
-    let _ = q
-        .reply(
-            q.key_expr().clone(),
-            serde_json::to_vec(a).expect("serialises"),
-        )
-        .wait();
+    pieces::reply(q, &serde_json::to_vec(a).expect("serialises"));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_events_text_is_bounded_from_a_characters_start() {
+        assert_eq!(bounded("short".into()), "short");
+        let long = "é".repeat(EVENT_TEXT); // 2 bytes each
+        let b = bounded(long);
+        assert!(b.starts_with("[…] é"), "{}", &b[..10]);
+        assert!(b.len() <= EVENT_TEXT + 8);
+        let json = serde_json::to_vec(&HostEvent::Failed("\u{1}".repeat(10 * EVENT_TEXT))).unwrap();
+        assert!(json.len() > 64 << 10, "the case the bound is for");
+        let json = serde_json::to_vec(&HostEvent::Failed(bounded("\u{1}".repeat(10 * EVENT_TEXT))));
+        assert!(json.unwrap().len() < 60 << 10);
+    }
 }

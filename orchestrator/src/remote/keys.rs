@@ -15,7 +15,7 @@ pub fn ping(name: &str) -> String {
     host(name, "ping")
 }
 
-/// A daemon's queryable that accepts a run ([`super::wire::RunRequest`]).
+/// A daemon's queryable that accepts a run ([`super::wire::RunOffer`]).
 #[must_use]
 pub fn run(name: &str) -> String {
     host(name, "run")
@@ -25,6 +25,13 @@ pub fn run(name: &str) -> String {
 #[must_use]
 pub fn end(name: &str) -> String {
     host(name, "end")
+}
+
+/// The orchestrator's queryable that hands host `host` its
+/// [`super::wire::RunRequest`], in pieces ([`super::pieces`]).
+#[must_use]
+pub fn request(run: &str, host: &str) -> String {
+    format!("attsync/{run}/request/{host}")
 }
 
 /// A daemon's liveliness token (gone: the daemon or its connection is lost).

@@ -7,7 +7,9 @@
 //!
 //! # Layout
 //! - [`keys`]: every Zenoh key; [`wire`]: requests, replies, events (JSON).
-//! - [`zconfig`]: the explicit Zenoh configuration (peer, endpoints, no scouting).
+//! - [`zconfig`]: the explicit Zenoh configuration (peer, endpoints, no
+//!   scouting, the low-latency transport).
+//! - [`pieces`]: payloads larger than one Zenoh batch, as replies in pieces.
 //! - [`link`]: a lossless, ordered, bounded stream (data + acknowledgements).
 //! - [`local`]: a run's namespace on one side, the stop flag and first failure.
 //! - [`bridge`], [`telemetry`]: the threads that carry states and telemetry.
@@ -22,6 +24,7 @@ pub mod host_run;
 pub mod keys;
 pub mod link;
 pub mod local;
+pub mod pieces;
 pub mod plan;
 pub mod telemetry;
 pub mod wire;

@@ -44,7 +44,18 @@ pub struct StateLink {
     pub receivers: Vec<u32>,
 }
 
-/// A run handed to a host (`attsync/host/<name>/run`).
+/// A run offered to a host (`attsync/host/<name>/run`): the host fetches
+/// its [`RunRequest`] from `attsync/<run>/request/<host>` (in pieces: it may
+/// exceed a Zenoh batch), starts its nodes, then answers.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct RunOffer {
+    /// The orchestrator's run id (Zenoh keys).
+    pub run: String,
+    /// The host's name.
+    pub host: String,
+}
+
+/// A run handed to a host, fetched after its [`RunOffer`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RunRequest {
     /// The orchestrator's run id (Zenoh keys).

@@ -62,6 +62,13 @@ pub fn peer(listen: &[String], connect: &[String]) -> Result<zenoh::Config, Conf
         ("scouting/multicast/enabled", "false".into()),
         ("scouting/gossip/enabled", "false".into()),
         ("transport/link/tx/lease", LEASE_MS.to_string()),
+        // Write each message from the calling thread, no TX task: ~20 %
+        // off an exchange across a cut (BENCHMARKS.md, session 11). It does
+        // not fragment, so larger payloads go in `pieces`; it needs QoS off,
+        // and every session of a run must use it (a peer with the default
+        // transport cannot open a link with it).
+        ("transport/unicast/lowlatency", "true".into()),
+        ("transport/unicast/qos/enabled", "false".into()),
     ];
     for (key, value) in settings {
         c.insert_json5(key, &value)
