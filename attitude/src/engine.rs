@@ -271,7 +271,20 @@ impl InProcess {
     pub fn run_with<T: Send>(
         &mut self,
         work: impl PerAgent<T> + Sync,
+        on_sample: impl OnSample<T>,
+    ) -> Option<Divergence> {
+        self.run_until(work, on_sample, || false)
+    }
+
+    /// [`Self::run_with`], asking `stop` after every step that is not a
+    /// sample: `true` ends the run there, with the last sample as its
+    /// last record ([`Self::last_sample`]) — what stops a run whose
+    /// samples are far apart (a stiff network's tiny `dt`) within one step.
+    pub fn run_until<T: Send>(
+        &mut self,
+        work: impl PerAgent<T> + Sync,
         mut on_sample: impl OnSample<T>,
+        stop: impl Fn() -> bool,
     ) -> Option<Divergence> {
         let mut outs = Vec::new();
         if self.step == 0 {
@@ -284,7 +297,7 @@ impl InProcess {
         }
         if self.threads > 1 && self.step < self.net.steps {
             self.ready = None;
-            let diverged = self.run_parallel((&work, &mut outs), on_sample);
+            let diverged = self.run_parallel((&work, &mut outs), on_sample, stop);
             self.refresh_states();
             return diverged;
         }
@@ -299,6 +312,9 @@ impl InProcess {
                 if !self.sample((&work, &mut outs), &mut on_sample) {
                     return None;
                 }
+            } else if stop() {
+                self.refresh_states();
+                return None;
             }
         }
         None
@@ -311,6 +327,7 @@ impl InProcess {
         &mut self,
         (work, all): Work<'_, T, impl PerAgent<T> + Sync>,
         mut on_sample: impl OnSample<T>,
+        stop: impl Fn() -> bool,
     ) -> Option<Divergence> {
         let Self {
             net,
@@ -355,7 +372,11 @@ impl InProcess {
                     return ended(&mine, Some(d));
                 }
                 if !due {
-                    crew::release(&board, true);
+                    let go_on = !stop();
+                    crew::release(&board, go_on);
+                    if !go_on {
+                        return ended(&mine, None);
+                    }
                     continue;
                 }
                 sampled.0 = *step;

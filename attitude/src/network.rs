@@ -11,6 +11,7 @@ use crate::observer::ObserverGains;
 use crate::reference::LeaderState;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
 
 /// What one node makes known to its neighbours at an exchange: an attitude,
 /// an angular velocity and an angular acceleration.
@@ -247,18 +248,32 @@ impl Network {
         self.agents.iter().position(|a| a.model.id == id)
     }
 
+    /// The index in `agents` of every agent id, built once: what a caller
+    /// that looks up many ids uses instead of [`Self::index_of`] (a scan).
+    /// A repeated id maps to its first agent, as [`Self::index_of`] does.
+    #[must_use]
+    pub fn index_by_id(&self) -> HashMap<u32, usize> {
+        let mut index = HashMap::with_capacity(self.agents.len());
+        for (k, a) in self.agents.iter().enumerate() {
+            index.entry(a.model.id).or_insert(k);
+        }
+        index
+    }
+
     /// For each agent, the index in `agents` of each of its neighbours (in
-    /// the order of its `model.neighbours`). Panics on an unvalidated network
-    /// whose neighbour ids are unknown.
+    /// the order of its `model.neighbours`), in time linear in the number of
+    /// edges. Panics on an unvalidated network whose neighbour ids are
+    /// unknown.
     #[must_use]
     pub fn neighbour_indices(&self) -> Vec<Vec<usize>> {
+        let index = self.index_by_id();
         self.agents
             .iter()
             .map(|a| {
                 a.model
                     .neighbours
                     .iter()
-                    .map(|n| self.index_of(n.id).expect("validated network"))
+                    .map(|n| *index.get(&n.id).expect("validated network"))
                     .collect()
             })
             .collect()

@@ -193,3 +193,30 @@ fn the_board_holds_what_every_receiver_would() {
         }
     }
 }
+
+/// `neighbour_indices` (one id map, linear in the edges) gives, for agents
+/// stored in any order, what looking each neighbour up by a scan gives:
+/// here the chain's agents stored in a shuffled order.
+#[test]
+fn neighbour_indices_follow_the_ids_in_any_storage_order() {
+    let mut net = chain(40, DT, 1, Coupling::Continuous);
+    // A fixed permutation: k ↦ 17k mod 40 (17 and 40 coprime).
+    let mut shuffled = net.agents.clone();
+    for (k, a) in net.agents.iter().enumerate() {
+        shuffled[(17 * k) % 40] = a.clone();
+    }
+    net.agents = shuffled;
+    let by_scan: Vec<Vec<usize>> = (net.agents.iter())
+        .map(|a| {
+            let ids = a.model.neighbours.iter().map(|n| n.id);
+            ids.map(|id| net.index_of(id).expect("a known id"))
+                .collect()
+        })
+        .collect();
+    assert_eq!(net.neighbour_indices(), by_scan);
+    let index = net.index_by_id();
+    assert_eq!(index.len(), 40);
+    for (k, a) in net.agents.iter().enumerate() {
+        assert_eq!(index[&a.model.id], k);
+    }
+}

@@ -7,10 +7,18 @@
 //! ([`Interrupt::install`]), with `signal-hook`'s async-signal-safe flag
 //! actions: each signal stores its number, then raises the flag the engines
 //! poll (an [`AtomicBool`], as [`crate::processes::run`] takes it).
+//!
+//! The flag is polled only once work that leaves something behind has
+//! begun (a staging directory, a namespace, nodes): the command says so with
+//! [`Interrupt::arm`]. Until then — reading and validating a scenario, which
+//! at 10⁵ agents takes seconds, or waiting on a FIFO — a signal ends the
+//! process at once with 128 + its number, as it would without a handler:
+//! a thread of the handler's own watches for the signals and exits while
+//! the interrupt is not armed.
 
 use std::io;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// The signals that interrupt a run.
 pub const SIGNALS: [i32; 3] = [
@@ -49,6 +57,9 @@ pub fn exit_code(signal: i32) -> u8 {
 pub struct Interrupt {
     flag: Arc<AtomicBool>,
     signal: Arc<AtomicUsize>,
+    /// Whether a command has begun work that the flag must stop (see
+    /// [`Interrupt::arm`]); the watching thread holds it while it exits.
+    armed: Arc<Mutex<bool>>,
 }
 
 impl Interrupt {
@@ -59,11 +70,12 @@ impl Interrupt {
         Self::default()
     }
 
-    /// A new interrupt raised by SIGINT, SIGTERM and SIGHUP (which then no
-    /// longer end the process by themselves).
+    /// A new interrupt raised by SIGINT, SIGTERM and SIGHUP. Until it is
+    /// [armed](Interrupt::arm) they end the process at once (exit 128 + the
+    /// signal's number); once armed they only raise the flag.
     ///
     /// # Errors
-    /// The OS refused a handler.
+    /// The OS refused a handler, or the watching thread could not start.
     pub fn install() -> io::Result<Self> {
         let i = Self::new();
         for sig in SIGNALS {
@@ -72,7 +84,24 @@ impl Interrupt {
             signal_hook::flag::register_usize(sig, i.signal.clone(), value)?;
             signal_hook::flag::register(sig, i.flag.clone())?;
         }
+        let mut signals = signal_hook::iterator::Signals::new(SIGNALS)?;
+        let armed = i.armed.clone();
+        std::thread::Builder::new()
+            .name("attsync-signals".into())
+            .spawn(move || {
+                for sig in signals.forever() {
+                    exit_unless_armed(&armed, sig);
+                }
+            })?;
         Ok(i)
+    }
+
+    /// From now on a signal only raises the flag, which the work polls to
+    /// stop cleanly: called by a command before it creates anything that
+    /// must be kept or removed. If a signal is already ending the process,
+    /// this waits for the end.
+    pub fn arm(&self) {
+        *self.armed.lock().unwrap_or_else(PoisonError::into_inner) = true;
     }
 
     /// Stops the work as `signal` would.
@@ -102,6 +131,17 @@ impl Interrupt {
         }
         let n = self.signal.load(Ordering::SeqCst);
         Some(i32::try_from(n).unwrap_or(signal_hook::consts::SIGINT))
+    }
+}
+
+/// Ends the process for `signal` (exit 128 + its number, the reason on
+/// stderr) unless the interrupt is armed; holds the lock while it exits, so
+/// [`Interrupt::arm`] cannot begin work the exit would abandon.
+fn exit_unless_armed(armed: &Mutex<bool>, signal: i32) {
+    let armed = armed.lock().unwrap_or_else(PoisonError::into_inner);
+    if !*armed {
+        eprintln!("attsync: {} before anything was written", reason(signal));
+        std::process::exit(exit_code(signal).into());
     }
 }
 

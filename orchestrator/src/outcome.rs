@@ -43,12 +43,13 @@ impl Outcome {
             })
             .collect();
         links.sort_by_key(|&(f, t, _)| (f, t));
-        // A diverged run reports what it recorded: the last snapshot's step
-        // and peak torques (as the process engine's last complete snapshot).
+        // A diverged or interrupted run reports what it recorded: the last
+        // snapshot's step and peak torques (as the process engine's last
+        // complete snapshot).
         let (sampled, peaks) = engine.last_sample();
-        let (steps, peak_torques) = match diverged {
-            Some(_) => (sampled, peaks.to_vec()),
-            None => (
+        let (steps, peak_torques) = match diverged.is_some() || interrupted {
+            true => (sampled, peaks.to_vec()),
+            false => (
                 engine.step_index(),
                 agents.iter().map(|a| a.peak_torque()).collect(),
             ),

@@ -154,6 +154,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     check_options(loaded, opts)?;
     plan(loaded, opts)?;
     check_capacity(loaded, opts)?;
+    interrupt.arm();
     let staging = Staging::claim(&opts.out).map_err(|e| match e {
         // A foreign or busy --out: refused before anything started (exit 2).
         e if e.is_refusal() => RunError::Options(OptionError::Conflict(e.to_string())),
@@ -227,11 +228,18 @@ fn drive(
             let mut engine = InProcess::new(net).with_threads(opts.threads);
             threads = Some(engine.threads());
             let mut interrupted = false;
-            // Each agent's row is made by the thread that steps it.
-            let diverged = engine.run_with(&row, |snap, rows| {
-                interrupted = interrupt.is_set();
-                !interrupted && record(snap, rows)
-            });
+            // Each agent's row is made by the thread that steps it; the
+            // interrupt is asked every step (samples may be far apart).
+            let diverged = engine.run_until(
+                &row,
+                |snap, rows| {
+                    interrupted = interrupt.is_set();
+                    !interrupted && record(snap, rows)
+                },
+                || interrupt.is_set(),
+            );
+            let stopped = diverged.is_none() && engine.step_index() < net.steps;
+            let interrupted = interrupted || (stopped && interrupt.is_set());
             Outcome::in_process(&engine, interrupted, diverged)
         }
         Engine::Processes => {

@@ -341,6 +341,7 @@ fn run_many(
 pub fn sweep(o: &SweepOptions, interrupt: &Interrupt) -> Result<SweepResult, SweepError> {
     o.validate()?;
     let base = load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
+    interrupt.arm();
     let staging = Staging::new(&o.run.out).map_err(io_at(&o.run.out))?;
     let dir = staging.path().to_owned();
     let mut rows = run_many(o, &dir, 0, &o.values, interrupt)?;

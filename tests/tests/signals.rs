@@ -124,3 +124,84 @@ fn sighup_stops_an_in_process_run_keeping_its_results() {
 fn sigint_stops_a_process_run_with_130() {
     check("processes", "INT", "SIGINT", 130);
 }
+
+/// Whether process `pid` has a thread named `name` (its `comm`).
+fn has_thread(pid: u32, name: &str) -> bool {
+    std::fs::read_dir(format!("/proc/{pid}/task"))
+        .into_iter()
+        .flatten()
+        .flatten()
+        .any(|t| std::fs::read_to_string(t.path().join("comm")).is_ok_and(|c| c.trim() == name))
+}
+
+/// A signal before anything is written — here attsync is blocked opening
+/// its scenario, a FIFO nobody writes to, as it would be reading and
+/// validating a large one — ends attsync at once with 128 + the signal's
+/// number, naming it, and leaves nothing (no `--out`, no lock, no staging).
+#[test]
+fn sigterm_while_the_scenario_is_read_ends_attsync_at_once() {
+    let tmp = Sandbox::new("signal-term-loading");
+    let fifo = tmp.join("scenario.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo {}", fifo.display());
+    let out = tmp.join("results");
+    let running = Attsync::new(tmp.path())
+        .args(run_args(&fifo, "processes", &out, &[]))
+        .spawn();
+    let pid = running.pid();
+    // The handler's watching thread exists: the signal comes after install.
+    let installed = wait_until(Duration::from_secs(10), POLL, || {
+        has_thread(pid, "attsync-signals").then_some(())
+    });
+    assert!(installed.is_some(), "no thread attsync-signals in {pid}");
+    std::thread::sleep(Duration::from_millis(200));
+    assert!(signal(pid, "TERM"), "kill -TERM {pid} failed");
+    let f = running.wait(Duration::from_secs(10));
+    f.assert_code(143);
+    assert!(
+        f.stderr.contains("interrupted by SIGTERM"),
+        "{}",
+        f.describe()
+    );
+    let left: Vec<_> = std::fs::read_dir(tmp.path())
+        .expect("the sandbox")
+        .flatten()
+        .map(|e| e.file_name())
+        .filter(|n| n != "scenario.toml")
+        .collect();
+    assert!(left.is_empty(), "left in the sandbox: {left:?}");
+    f.assert_no_leftovers();
+}
+
+/// SIGTERM between two samples far apart (20 000 s of simulated time, some
+/// 20 million steps) stops an in-process run within a step, not at the next
+/// sample: exit 143, the results so far kept (the sample at t = 0),
+/// `summary.json` counting the steps that were recorded.
+#[test]
+fn sigterm_between_far_samples_stops_an_in_process_run_at_once() {
+    let tmp = Sandbox::new("signal-term-far-samples");
+    let out = tmp.join("results");
+    let sets = ["simulation.duration=40000", "output.sample_period=20000"];
+    let mut running = Attsync::new(tmp.path())
+        .args(run_args(&paper("timevarying"), "in-process", &out, &sets))
+        .spawn();
+    let pid = running.pid();
+    // The rows of t = 0 sit in a buffer until the run ends: wait for the
+    // staging directory, then for the engine to be well inside the steps.
+    let marker = staging_dir(&out, pid).join(".attsync-run");
+    let staged = wait_until(Duration::from_secs(60), POLL, || {
+        (running.has_ended() || marker.exists()).then_some(())
+    });
+    assert!(staged.is_some() && !running.has_ended(), "never staged");
+    std::thread::sleep(Duration::from_millis(1500));
+    assert!(!running.has_ended(), "ended before it was signalled");
+    assert!(signal(pid, "TERM"), "kill -TERM {pid} failed");
+    let f = running.wait(Duration::from_secs(5));
+    f.assert_code(143);
+    let s = summary(&out);
+    assert_eq!(s["complete"], false, "{s:#}");
+    assert_eq!(s["incomplete_reason"], "interrupted by SIGTERM", "{s:#}");
+    assert_eq!(s["steps"], 0, "the last recorded sample is t = 0: {s:#}");
+    assert_eq!(csv_rows(&read(&out.join("errors.csv"))), 7, "t = 0's rows");
+    f.assert_no_leftovers();
+}

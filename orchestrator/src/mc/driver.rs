@@ -101,6 +101,7 @@ fn check_capacity(base: &Base, o: &McOptions) -> Result<(), McError> {
 pub fn monte_carlo(o: &McOptions, interrupt: &Interrupt) -> Result<McRun, McError> {
     let base = load_base(o)?;
     check_capacity(&base, o)?;
+    interrupt.arm();
     let staging = Staging::claim(&o.out).map_err(|e| match e {
         e if e.is_refusal() => McError::Options(OptionError::Conflict(e.to_string())),
         e => McError::Io {

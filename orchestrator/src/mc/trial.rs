@@ -10,7 +10,7 @@ use crate::interrupt::Interrupt;
 use crate::options::StiffnessCheck;
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::scenario::{self, Loaded, ScenarioError};
-use attitude::engine::InProcess;
+use attitude::engine::{InProcess, Snapshot};
 use std::path::{Path, PathBuf};
 
 /// The scenario every trial starts from: its text (read once), the
@@ -92,14 +92,15 @@ pub fn run_in_process(p: &Prepared, tolerance: f64, interrupt: &Interrupt) -> Ra
     let mut trace = Trace::new(net.dt, has_observer(p));
     let mut engine = InProcess::new(net);
     let mut stopped = false;
-    let diverged = engine.run(|snap| {
+    let on_sample = |snap: &Snapshot<'_>, _: &[()]| {
         stopped = interrupt.is_set();
         if !stopped {
             trace.record(snap);
         }
         !stopped
-    });
-    if stopped {
+    };
+    let diverged = engine.run_until(|_, _, _| (), on_sample, || interrupt.is_set());
+    if stopped || (diverged.is_none() && engine.step_index() < net.steps) {
         return Ran::Interrupted;
     }
     let end = match diverged {

@@ -77,6 +77,7 @@ pub fn verify(
     let text = scenario_text(&layout, &manifest)?;
     let changed = files::check(dir, &manifest.files);
     let loaded = load(&layout, &manifest, &text)?;
+    interrupt.arm();
     let tmp = tempfile::Builder::new()
         .prefix("attsync-verify-")
         .tempdir()

@@ -64,13 +64,14 @@ pub fn layout(net: &Network) -> Layout {
 fn adjacency(net: &Network) -> Vec<Vec<usize>> {
     let n = net.agents.len() + 1;
     let mut adj = vec![Vec::new(); n];
+    let index = net.index_by_id();
     for (k, a) in net.agents.iter().enumerate() {
         if a.model.leader_gain.is_some() {
             adj[0].push(k + 1);
             adj[k + 1].push(0);
         }
         for nb in &a.model.neighbours {
-            if let Some(j) = net.index_of(nb.id) {
+            if let Some(&j) = index.get(&nb.id) {
                 adj[k + 1].push(j + 1);
             }
         }

@@ -26,6 +26,7 @@ pub fn exec(a: Host, interrupt: &Interrupt) -> Result<(), Error> {
         listen: a.listen,
         connect: a.connect,
     };
+    interrupt.arm();
     daemon::serve(&opts, interrupt.flag())?;
     Ok(())
 }
