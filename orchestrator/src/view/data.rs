@@ -83,10 +83,12 @@ pub fn view_data(net: &Network, run: RunInfo, frames: Frames) -> ViewData {
     let scale = room / largest.max(f64::MIN_POSITIVE);
     let h = 0.6 * room;
     let cube = [[h, 0.0, 0.0], [0.0, h, 0.0], [0.0, 0.0, h]];
+    let mut linked = vec![false; pos.len()];
+    leader_links.iter().for_each(|&v| linked[v] = true);
     let mut bodies = vec![body(0, pos[0], cube, 0, false)];
     for (k, a) in net.agents.iter().enumerate() {
         let axes = boxes[k].map(|v| v.map(|x| x * scale));
-        let linked = leader_links.contains(&(k + 1));
+        let linked = linked[k + 1];
         bodies.push(body(a.model.id, pos[k + 1], axes, depth[k + 1], linked));
     }
     let observer = net
