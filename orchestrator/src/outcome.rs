@@ -47,12 +47,13 @@ impl Outcome {
         // snapshot's step and peak torques (as the process engine's last
         // complete snapshot).
         let (sampled, peaks) = engine.last_sample();
-        let (steps, peak_torques) = match diverged.is_some() || interrupted {
-            true => (sampled, peaks.to_vec()),
-            false => (
+        let (steps, peak_torques) = if diverged.is_some() || interrupted {
+            (sampled, peaks.to_vec())
+        } else {
+            (
                 engine.step_index(),
                 agents.iter().map(|a| a.peak_torque()).collect(),
-            ),
+            )
         };
         Self {
             peak_torques,

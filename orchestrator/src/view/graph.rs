@@ -141,9 +141,10 @@ fn place_unreached(pos: &mut [[f64; 2]], depth: &mut [usize], parent: &[Option<u
 }
 
 /// The smallest distance between two nodes of `pos` (1 for fewer than two,
-/// or when all coincide): a sweep in x keeping the nodes within the best
-/// distance so far ordered by y, O(N log N) (a 10⁵-agent view is laid out
-/// in milliseconds, not in the minutes of all pairs).
+/// or when all coincide; coincident nodes do not count): a sweep in x
+/// keeping the nodes within the best distance so far ordered by y,
+/// O(N log N) (a 10⁵-agent view is laid out in milliseconds, not in the
+/// minutes of all pairs).
 #[must_use]
 pub fn min_distance(pos: &[[f64; 2]]) -> f64 {
     let mut by_x: Vec<[f64; 2]> = pos
@@ -151,44 +152,32 @@ pub fn min_distance(pos: &[[f64; 2]]) -> f64 {
         .copied()
         .filter(|p| p[0].is_finite() && p[1].is_finite())
         .collect();
-    by_x.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]));
+    by_x.sort_unstable_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    // Without coincident nodes, few lie within d of a node (they are d apart).
+    by_x.dedup();
     let mut d = f64::INFINITY;
-    let mut near: BTreeSet<(Ordered, usize)> = BTreeSet::new();
+    let mut near: BTreeSet<(i64, usize)> = BTreeSet::new();
     let mut tail = 0;
     for (i, p) in by_x.iter().enumerate() {
         while tail < i && p[0] - by_x[tail][0] > d {
-            near.remove(&(Ordered(by_x[tail][1]), tail));
+            near.remove(&(ordered(by_x[tail][1]), tail));
             tail += 1;
         }
-        let (lo, hi) = (Ordered(p[1] - d), Ordered(p[1] + d));
+        let (lo, hi) = (ordered(p[1] - d), ordered(p[1] + d));
         for &(_, j) in near.range((lo, 0)..=(hi, usize::MAX)) {
-            let q = by_x[j];
-            let r = (p[0] - q[0]).hypot(p[1] - q[1]);
-            if r > 0.0 {
-                d = d.min(r);
-            }
+            d = d.min((p[0] - by_x[j][0]).hypot(p[1] - by_x[j][1]));
         }
-        near.insert((Ordered(p[1]), i));
+        near.insert((ordered(p[1]), i));
     }
     if d.is_finite() { d } else { 1.0 }
 }
 
-/// An `f64` ordered by `total_cmp` (finite values here), for the sweep.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Ordered(f64);
-
-impl Eq for Ordered {}
-
-impl PartialOrd for Ordered {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Ordered {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&other.0)
-    }
+/// `y` as an integer in the order of [`f64::total_cmp`] (the same bit
+/// trick), a key of the sweep's ordered set.
+fn ordered(y: f64) -> i64 {
+    // Reinterpreting casts, on purpose (the bits of y as a signed integer).
+    let bits = y.to_bits() as i64;
+    bits ^ (((bits >> 63) as u64) >> 1) as i64
 }
 
 #[cfg(test)]
