@@ -11,7 +11,8 @@
 //!   [`WriteError`] (naming the file).
 //! - [`summary`]: `summary.json` ([`Summary`]) and the end-of-run table.
 //! - [`states`]: `states.bin`, its byte layout, reader and CSV export.
-//! - [`plot`]: draws `errors.svg`.
+//! - [`plot`]: draws `errors.svg`; [`envelope`]: what it draws of many
+//!   agents (their band) and of many samples (thinned lines).
 //! - [`staging`]: the atomic results directory (`.NAME.partial-PID`), replacing
 //!   only a directory marked as attsync's.
 //! - [`lock`]: the lock (`.NAME.lock`) serialising runs into one directory.
@@ -20,6 +21,7 @@
 //!   and files; [`platform`]: the machine it records.
 
 pub mod digest;
+pub mod envelope;
 pub mod layout;
 pub mod lock;
 pub mod manifest;

@@ -3,12 +3,15 @@
 //! the scheme has an observer, its errors `|R̂ᵢ R₀ᵀ|_I` and `‖ω̂ᵢ − ω₀‖` in
 //! two more panels; in real-time runs, the age of information of every
 //! link (mean and largest, as `summary.json` `links[]` has them: the runs
-//! record no time series of it).
+//! record no time series of it). A network of more than
+//! [`EACH_AGENT_UP_TO`] agents is drawn as the band of its agents' errors,
+//! and every line is thinned to [`POINTS_PER_LINE`] points (`envelope.rs`).
 //!
 //! Also the look every attsync chart shares (`errors.svg` here, `mc.svg` in
 //! `mc/plot.rs`): `canvas`, `chart`, `line`, `bars`, `legend`.
 
 use super::Series;
+use super::envelope::{Band, EACH_AGENT_UP_TO, POINTS_PER_LINE, band, decimate};
 use super::summary::LinkSummary;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -109,7 +112,7 @@ fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     label: &str,
     series: &[Series],
-    pick: impl Fn(&Series) -> &Vec<f64>,
+    pick: impl Fn(&Series) -> &[f64],
 ) -> Result<(), String> {
     let t_end = series
         .iter()
@@ -136,13 +139,64 @@ fn panel<DB: DrawingBackend>(
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(|e| e.to_string())?;
-    for (k, s) in series.iter().enumerate() {
-        let color = Palette99::pick(k).to_rgba();
-        let points = s.t.iter().zip(pick(s)).map(|(&t, &y)| (t, y.max(FLOOR)));
-        let name = format!("agent {}", s.id);
-        line(&mut chart, points, color.stroke_width(2), name)?;
+    if series.len() > EACH_AGENT_UP_TO {
+        band_of_agents(&mut chart, series.len(), &band(series, &pick))?;
+    } else {
+        for (k, s) in series.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let points = decimate(&s.t, pick(s), POINTS_PER_LINE);
+            let name = format!("agent {}", s.id);
+            line(&mut chart, floored(points), color.stroke_width(2), name)?;
+        }
     }
     legend(&mut chart, SeriesLabelPosition::UpperRight)
+}
+
+/// The errors of `agents` agents as their band `b`: shaded from the
+/// smallest to the largest, with the largest, the median and the smallest
+/// drawn as lines (each thinned to [`POINTS_PER_LINE`]).
+fn band_of_agents<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    agents: usize,
+    b: &Band,
+) -> Result<(), String>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let upper = floored(decimate(&b.t, &b.max, POINTS_PER_LINE));
+    let lower = floored(decimate(&b.t, &b.min, POINTS_PER_LINE));
+    let outline: Vec<(f64, f64)> = upper.clone().chain(lower.clone().rev()).collect();
+    let shade = Palette99::pick(0).mix(0.2).filled();
+    (chart.draw_series(std::iter::once(Polygon::new(outline, shade))))
+        .map_err(|e| e.to_string())?;
+    let lines = [
+        (
+            format!("largest of {agents} agents"),
+            upper.collect::<Vec<_>>(),
+            1,
+        ),
+        (
+            "median".into(),
+            floored(decimate(&b.t, &b.median, POINTS_PER_LINE)).collect(),
+            2,
+        ),
+        ("smallest".into(), lower.collect(), 3),
+    ];
+    for (name, points, k) in lines {
+        line(
+            chart,
+            points,
+            Palette99::pick(k).to_rgba().stroke_width(2),
+            name,
+        )?;
+    }
+    Ok(())
+}
+
+/// `points` with values below the log axes' [`FLOOR`] raised to it.
+fn floored(points: Vec<(f64, f64)>) -> impl DoubleEndedIterator<Item = (f64, f64)> + Clone {
+    points.into_iter().map(|(t, y)| (t, y.max(FLOOR)))
 }
 
 /// A white SVG canvas of `size` px written to `file`, titled `title`
@@ -268,6 +322,47 @@ mod tests {
         let without = svg(&series(false), &[]);
         assert!(!without.contains(OBSERVER_ATT) && !without.contains(OBSERVER_ANGVEL));
         assert!(without.contains("attitude error |R_i R_0^T|_I"));
+    }
+
+    fn agents(n: u32, samples: usize) -> Vec<Series> {
+        let t: Vec<f64> = (0..samples).map(|k| k as f64 * 0.01).collect();
+        (1..=n)
+            .map(|id| Series {
+                id,
+                att: t.iter().map(|t| (-t * f64::from(id)).exp()).collect(),
+                angvel: t.iter().map(|t| (-t).exp() / f64::from(id)).collect(),
+                t: t.clone(),
+                ..Series::default()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_large_network_is_drawn_as_its_band_whatever_its_size() {
+        let few = svg(&agents(EACH_AGENT_UP_TO as u32, 50), &[]);
+        assert!(few.contains("agent 16") && !few.contains("largest of"));
+        let hundred = svg(&agents(100, 50), &[]);
+        let thousands = svg(&agents(5000, 50), &[]);
+        assert!(thousands.contains("largest of 5000 agents") && thousands.contains("median"));
+        assert!(
+            !thousands.contains("agent 1<"),
+            "one legend entry per agent"
+        );
+        let (a, b) = (hundred.len() as f64, thousands.len() as f64);
+        assert!(
+            (b / a - 1.0).abs() < 0.1,
+            "{a} B for 100 agents, {b} B for 5000"
+        );
+    }
+
+    #[test]
+    fn a_long_run_is_thinned_to_a_drawing_of_bounded_size() {
+        let short = svg(&agents(2, POINTS_PER_LINE), &[]).len() as f64;
+        let long = svg(&agents(2, 50 * POINTS_PER_LINE), &[]).len() as f64;
+        assert!(
+            long < 1.5 * short,
+            "{short} B, then {long} B for 50× the samples"
+        );
     }
 
     #[test]
