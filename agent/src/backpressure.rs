@@ -87,13 +87,27 @@ pub fn next_pause(pause: Duration, sent: u32, buffer: u32) -> Duration {
 
 /// A backpressure handler: sleep for the pacer's pause and retry until
 /// `timeout`, then give up on that receiver and fail the send (so nothing
-/// hangs).
+/// hangs). It also gives up at once when the node's parent (the
+/// orchestrator, whose pid is read when the handler is made) is gone: a
+/// dead receiver's buffer stays full, and a sender waiting on it must still
+/// exit within a second of the orchestrator's death (PROTOCOL.md § 6: a
+/// node exits if its parent process changes).
 pub fn retry_until(
     timeout: Duration,
     pacer: Pacer,
 ) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send + 'static {
+    retry_until_parent(timeout, pacer, std::os::unix::process::parent_id())
+}
+
+/// [`retry_until`] for a node whose parent is `parent`.
+fn retry_until_parent(
+    timeout: Duration,
+    pacer: Pacer,
+    parent: u32,
+) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send + 'static {
     move |info| {
-        if info.elapsed_time > timeout {
+        let orphaned = || std::os::unix::process::parent_id() != parent;
+        if info.elapsed_time > timeout || orphaned() {
             BackpressureAction::DiscardDataAndFail
         } else {
             std::thread::sleep(pacer.pause());
@@ -105,6 +119,36 @@ pub fn retry_until(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn full(elapsed: Duration) -> BackpressureInfo {
+        BackpressureInfo {
+            service_id: 0,
+            sender_port_id: 0,
+            receiver_port_id: 0,
+            retries: 1,
+            elapsed_time: elapsed,
+        }
+    }
+
+    #[test]
+    fn a_full_receiver_is_retried_until_the_timeout_or_the_parents_death() {
+        let parent = std::os::unix::process::parent_id();
+        let timeout = Duration::from_secs(10);
+        let ours = retry_until_parent(timeout, Pacer::new(64), parent);
+        assert!(matches!(
+            ours(&full(Duration::ZERO)),
+            BackpressureAction::Retry
+        ));
+        let late = full(timeout + Duration::from_millis(1));
+        assert!(matches!(
+            ours(&late),
+            BackpressureAction::DiscardDataAndFail
+        ));
+        // A parent that is not ours any more: the orchestrator died.
+        let gone = retry_until_parent(timeout, Pacer::new(64), parent.wrapping_add(1));
+        let now = gone(&full(Duration::ZERO));
+        assert!(matches!(now, BackpressureAction::DiscardDataAndFail));
+    }
 
     #[test]
     fn a_sender_that_refills_little_per_wake_up_sleeps_longer_up_to_the_max() {
