@@ -16,10 +16,10 @@ use crate::processes::namespace::Namespace;
 use crate::processes::node_log::last_bytes;
 use crate::processes::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
 use iceoryx2::prelude::*;
-use msgs::ControlMsg;
 use msgs::bytes::Bytes;
 use msgs::config::Contention;
 use msgs::iox::iox;
+use msgs::{ControlCommand, ControlMsg};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -279,11 +279,7 @@ fn watch(
             let k = e.index;
             exits[k] = Some(e);
         }
-        while let Ok(Some(s)) = ports.control.try_recv() {
-            if let Ok(m) = ControlMsg::from_bytes(&s.payload().to_bytes()) {
-                let _ = res.control.send_copy(m);
-            }
-        }
+        relay_control(ports, res);
         if let (Some(f), false) = (shared.failure(), failed_said) {
             failed_said = true;
             ports.put(&HostEvent::Failed(bounded(f)));
@@ -295,11 +291,28 @@ fn watch(
             return None;
         }
         match commands.recv_timeout(TICK) {
-            Ok(Command::End(e, q)) => return Some((e, q)),
+            Ok(Command::End(e, q)) => {
+                relay_control(ports, res);
+                if !e.kill {
+                    // A clean end comes after the orchestrator's `Stop`,
+                    // but on another Zenoh path that may overtake it.
+                    let _ = res.control.send_copy(ControlMsg::new(ControlCommand::Stop));
+                }
+                return Some((e, q));
+            }
             Ok(Command::Abort) | Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
                 return None;
             }
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+        }
+    }
+}
+
+/// Relays the orchestrator's control messages received so far into the namespace.
+fn relay_control(ports: &RunPorts, res: &Resources) {
+    while let Ok(Some(s)) = ports.control.try_recv() {
+        if let Ok(m) = ControlMsg::from_bytes(&s.payload().to_bytes()) {
+            let _ = res.control.send_copy(m);
         }
     }
 }

@@ -76,7 +76,9 @@ pub type Answer = Result<(), String>;
 pub struct EndRequest {
     /// The orchestrator's run id.
     pub run: String,
-    /// Kill the nodes at once (the run failed), else wait for them to exit.
+    /// Kill the nodes at once (the run failed), else wait for them to exit
+    /// (the run is complete: it implies `Stop`, which the daemon relays
+    /// again in case the end overtook it).
     pub kill: bool,
 }
 
