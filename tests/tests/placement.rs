@@ -1,6 +1,8 @@
 //! `--placement`: where a run's node processes may run. `pack` puts every
-//! node on one core, `spread` leaves them on every core, `auto` (the
-//! default) packs only while other programs keep the machine busy — tested
+//! node on one core, `spread` leaves them on every core, `pin` pins each
+//! node to one core (the graph cut into a part per core), `auto` (the
+//! default) pins like `pin` while the machine is idle (unit tests:
+//! `placement::tests`) and packs while other programs keep it busy — tested
 //! here with as many CPU-bound competitors as cores. The placement never
 //! changes what a node computes: results are byte-identical.
 //!
@@ -30,15 +32,23 @@ fn allowed(run: &str, id: u32) -> Option<String> {
         .map(|s| s.trim().to_string())
 }
 
+/// The paper run's nodes: the leader and 7 agents.
+const NODES: u32 = 8;
+
+/// The CPUs every node of `run` may run on, if every node is there.
+fn allowed_all(run: &str) -> Option<Vec<String>> {
+    (0..NODES).map(|id| allowed(run, id)).collect()
+}
+
 /// Runs the paper's scheme-1 scenario for `duration` s with `args`, and
-/// waits (bounded) until `seen(allowed CPUs of agent 1)` holds while it
+/// waits (bounded) until `seen(allowed CPUs of each node)` holds while it
 /// steps. Returns whether it was seen; the run is waited for and must succeed.
 fn run_and_watch(
     sb: &Sandbox,
     out: &str,
     duration: &str,
     args: &[&str],
-    seen: impl Fn(&str) -> bool,
+    seen: impl Fn(&[String]) -> bool,
 ) -> bool {
     let set = format!("simulation.duration={duration}");
     let running = Attsync::new(sb.path())
@@ -56,7 +66,7 @@ fn run_and_watch(
     })
     .expect("the run's namespace");
     let hit = wait_until(Duration::from_secs(60), POLL, || {
-        allowed(&run, 1).filter(|a| seen(a)).map(|_| ())
+        allowed_all(&run).filter(|a| seen(a)).map(|_| ())
     })
     .is_some();
     running
@@ -68,6 +78,16 @@ fn run_and_watch(
 
 fn single_core(list: &str) -> bool {
     !list.contains('-') && !list.contains(',')
+}
+
+/// Every node on one and the same core.
+fn packed(lists: &[String]) -> bool {
+    lists.iter().all(|l| single_core(l)) && lists.iter().all(|l| *l == lists[0])
+}
+
+/// Every node on a single core, the nodes over more than one core.
+fn pinned_apart(lists: &[String]) -> bool {
+    lists.iter().all(|l| single_core(l)) && lists.iter().any(|l| *l != lists[0])
 }
 
 /// CPU-bound competitors, killed when dropped.
@@ -104,19 +124,36 @@ fn pack_puts_every_node_on_one_core_and_changes_no_result() {
         return;
     }
     let sb = Sandbox::new("placement-pack");
-    let packed = run_and_watch(&sb, "packed", "20", &["--placement", "pack"], single_core);
+    let was_packed = run_and_watch(&sb, "packed", "20", &["--placement", "pack"], packed);
     assert!(
-        packed,
-        "agent 1 never ran on a single core with --placement pack"
+        was_packed,
+        "the nodes never ran on one core with --placement pack"
     );
     let spread = run_and_watch(&sb, "spread", "20", &["--placement", "spread"], |a| {
-        !single_core(a)
+        a.iter().all(|l| !single_core(l))
     });
     assert!(
         spread,
-        "agent 1 ran on a single core with --placement spread"
+        "a node ran on a single core with --placement spread"
     );
     assert_same_results(&sb.join("packed"), &sb.join("spread"));
+}
+
+#[test]
+fn pin_puts_each_node_on_one_core_of_several_and_changes_no_result() {
+    if cores() < 2 {
+        eprintln!("one core: nothing to pin apart");
+        return;
+    }
+    let sb = Sandbox::new("placement-pin");
+    let pinned = run_and_watch(&sb, "pinned", "20", &["--placement", "pin"], pinned_apart);
+    assert!(
+        pinned,
+        "with --placement pin the nodes were never each on one core, over several"
+    );
+    let spread = run_and_watch(&sb, "spread", "20", &["--placement", "spread"], |_| true);
+    assert!(spread);
+    assert_same_results(&sb.join("pinned"), &sb.join("spread"));
 }
 
 #[test]
@@ -127,10 +164,10 @@ fn auto_packs_while_competitors_keep_every_core_busy() {
     }
     let sb = Sandbox::new("placement-auto");
     let burners = Burners::start(cores());
-    let packed = run_and_watch(&sb, "auto", "10", &[], single_core);
+    let was_packed = run_and_watch(&sb, "auto", "10", &[], packed);
     drop(burners);
     assert!(
-        packed,
+        was_packed,
         "with {} competitors the nodes were never packed",
         cores()
     );

@@ -4,9 +4,9 @@
 //! [`Window`] per sampling period.
 
 use super::placement::{
-    FIRST_WINDOW, HYSTERESIS, Placed, Placement, State, WINDOW, Window, decide, least_busy, place,
+    Cores, FIRST_WINDOW, HYSTERESIS, Placed, Placement, State, WINDOW, Window, decide, least_busy,
+    place,
 };
-use nix::sched::CpuSet;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Busy and total ticks of each core, by core number.
@@ -93,25 +93,19 @@ fn window(a: &Sample, b: &Sample) -> Window {
 }
 
 /// Samples every [`WINDOW`] until `stop`, placing `pids` per `placement`.
-pub(super) fn watch(
-    placement: Placement,
-    pids: &[u32],
-    allowed: &CpuSet,
-    cores: &[usize],
-    stop: &AtomicBool,
-) {
+pub(super) fn watch(placement: Placement, pids: &[u32], cores: &Cores, stop: &AtomicBool) {
     // The first decision takes one short window: a run should not spend
     // its first half second spread over a busy machine.
     let mut state = State {
         placed: Placed::Spread,
         streak: HYSTERESIS - 1,
     };
-    let mut last = sample(pids, cores);
+    let mut last = sample(pids, &cores.list);
     let mut period = FIRST_WINDOW;
     while !stop.load(Ordering::Relaxed) {
         std::thread::sleep(period);
         period = WINDOW;
-        let now = sample(pids, cores);
+        let now = sample(pids, &cores.list);
         let w = window(&last, &now);
         last = now;
         let next = match placement {
@@ -120,7 +114,7 @@ pub(super) fn watch(
                 placed: least_busy(&w).map_or(Placed::Spread, Placed::Packed),
                 streak: 0,
             },
-            Placement::Pack | Placement::Spread => state,
+            Placement::Pack | Placement::Spread | Placement::Pin => state,
         };
         if next.placed != state.placed {
             tracing::info!(
@@ -129,11 +123,12 @@ pub(super) fn watch(
                 "placement: other programs use {:.1} cores; nodes {}",
                 w.foreign,
                 match next.placed {
-                    Placed::Spread => "spread over every core".to_string(),
+                    Placed::Spread if cores.pinned.is_empty() => "spread over every core".into(),
+                    Placed::Spread => "each on its part's core".into(),
                     Placed::Packed(c) => format!("packed onto core {c}"),
                 }
             );
-            place(pids, next.placed, allowed);
+            place(pids, next.placed, cores);
         }
         state = next;
     }

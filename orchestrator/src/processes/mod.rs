@@ -30,6 +30,7 @@ mod configs;
 mod load;
 pub mod namespace;
 pub mod node_log;
+mod partition;
 pub mod placement;
 pub mod ports;
 pub mod reaper;
@@ -158,7 +159,8 @@ pub fn run(
     );
     s.spawn_nodes()?;
     let remote_started = s.start_remote();
-    let placer = placement::Placer::start(opts.placement, s.sup.pids().to_vec());
+    let graph = local_graph(net, s.sup.indices());
+    let placer = placement::Placer::start(opts.placement, s.sup.pids().to_vec(), &graph);
     tracing::debug!("processes: spawned, waiting for Ready");
     let failure = remote_started
         .and_then(|()| s.await_ready())
@@ -174,4 +176,40 @@ pub fn run(
     let failure = s.shutdown(failure);
     tracing::debug!("processes: shut down, namespace removed");
     Ok(s.nodes.outcome(failure))
+}
+
+/// The graph of the nodes started here, `indices[k]` being node `k`'s index
+/// (0 the leader, `i + 1` agent `net.agents[i]`): for each, the positions in
+/// `indices` of its neighbours and, for the leader, of the agents it leads.
+fn local_graph(net: &Network, indices: &[usize]) -> Vec<Vec<usize>> {
+    let index_of_id: std::collections::HashMap<u32, usize> = (net.agents.iter().enumerate())
+        .map(|(i, a)| (a.model.id, i + 1))
+        .collect();
+    let mut position = vec![usize::MAX; net.agents.len() + 1];
+    for (k, &i) in indices.iter().enumerate() {
+        position[i] = k;
+    }
+    let mut adj = vec![Vec::new(); indices.len()];
+    let mut link = |a: usize, b: usize| {
+        if position[a] != usize::MAX && position[b] != usize::MAX {
+            adj[position[a]].push(position[b]);
+        }
+    };
+    for (i, a) in net.agents.iter().enumerate() {
+        for n in &a.model.neighbours {
+            if let Some(&j) = index_of_id.get(&n.id) {
+                link(i + 1, j);
+                link(j, i + 1);
+            }
+        }
+        if a.model.leader_gain.is_some() {
+            link(i + 1, 0);
+            link(0, i + 1);
+        }
+    }
+    for ws in &mut adj {
+        ws.sort_unstable();
+        ws.dedup();
+    }
+    adj
 }

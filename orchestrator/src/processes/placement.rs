@@ -1,6 +1,9 @@
 //! Where a run's node processes may run: spread over every core the
 //! orchestrator may use, or packed onto one core while other programs keep
-//! the machine busy ([`Placement::Auto`], the default).
+//! the machine busy ([`Placement::Auto`], the default). `Auto` spreads a run
+//! with more nodes than cores by pinning each node to one core, the graph
+//! cut into a part per core ([`super::partition`]): the scheduler would
+//! otherwise migrate them and every migration costs cold caches.
 //!
 //! Why: in lockstep every exchange hands the turn from node to node. Across
 //! cores each hand-off is a wake-up of a sleeping process on another CPU (an
@@ -16,6 +19,7 @@
 //! The [`Placer`] thread samples `/proc/stat` and each node's
 //! `/proc/<pid>/stat` every [`WINDOW`]; [`decide`] is the policy, pure.
 
+use super::partition::{cut_edges, partition};
 use msgs::config::Contention;
 use nix::sched::{CpuSet, sched_getaffinity, sched_setaffinity};
 use nix::unistd::Pid;
@@ -26,13 +30,18 @@ use std::time::Duration;
 /// How node processes are placed on the cores.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Placement {
-    /// Spread while the machine is idle, pack onto one core while it is busy.
+    /// Spread while the machine is idle (each node pinned to the core of
+    /// its part of the graph when nodes outnumber cores), pack onto one core
+    /// while it is busy.
     #[default]
     Auto,
     /// Every core the orchestrator may use (the scheduler decides).
     Spread,
     /// One core for the whole run.
     Pack,
+    /// Each node pinned to one core, the graph cut into a part per core,
+    /// whatever the load (for a machine kept for the run).
+    Pin,
 }
 
 /// Foreign load (cores) at or above which `Auto` packs.
@@ -49,7 +58,8 @@ pub const HYSTERESIS: u32 = 2;
 /// What the run's nodes are placed on now.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Placed {
-    /// Every allowed core.
+    /// Every allowed core (each node on its part's core, if the run is
+    /// partitioned: [`Cores::pinned`]).
     Spread,
     /// This core.
     Packed(usize),
@@ -125,9 +135,9 @@ fn cores_of(set: &CpuSet) -> Vec<usize> {
 }
 
 /// Whether a [`Placer`] for `placement` watches the load with `cores`
-/// cores to place on (not for `Spread`, and not on a single core).
+/// cores to place on (`Auto` and `Pack`, not on a single core).
 fn watches(placement: Placement, cores: usize) -> bool {
-    cores > 1 && placement != Placement::Spread
+    cores > 1 && matches!(placement, Placement::Auto | Placement::Pack)
 }
 
 /// Who copes with competing programs when the run is placed by
@@ -150,20 +160,64 @@ pub struct Placer {
     thread: Option<std::thread::JoinHandle<()>>,
 }
 
+/// The cores a run may use, and where each of its nodes goes while spread.
+#[derive(Debug, Clone)]
+pub(super) struct Cores {
+    /// Every core the orchestrator may use.
+    pub allowed: CpuSet,
+    /// Their numbers.
+    pub list: Vec<usize>,
+    /// Per node (in `pids` order) its core while spread; empty: any allowed core.
+    pub pinned: Vec<usize>,
+}
+
+impl Cores {
+    /// For `placement` of nodes whose graph is `adjacency` (one entry per
+    /// node, in `pids` order): pinned by [`partition`] under `Pin`, and
+    /// under `Auto` when the nodes outnumber the cores.
+    fn of(placement: Placement, allowed: CpuSet, adjacency: &[Vec<usize>]) -> Self {
+        let list = cores_of(&allowed);
+        let pin = match placement {
+            Placement::Auto => adjacency.len() > list.len(),
+            Placement::Pin => true,
+            Placement::Spread | Placement::Pack => false,
+        };
+        let pinned = if pin && list.len() > 1 {
+            let part = partition(adjacency, list.len());
+            tracing::debug!(
+                nodes = part.len(),
+                cores = list.len(),
+                cut_edges = cut_edges(adjacency, &part),
+                "placement: each node pinned to its part's core"
+            );
+            part.iter().map(|&p| list[p]).collect()
+        } else {
+            Vec::new()
+        };
+        Self {
+            allowed,
+            list,
+            pinned,
+        }
+    }
+}
+
 impl Placer {
-    /// Starts placing the processes `pids` by `placement`.
+    /// Starts placing the processes `pids` by `placement`; `adjacency[k]`
+    /// lists the positions in `pids` of node `k`'s neighbours.
     #[must_use]
-    pub fn start(placement: Placement, pids: Vec<u32>) -> Self {
+    pub fn start(placement: Placement, pids: Vec<u32>, adjacency: &[Vec<usize>]) -> Self {
         let stop = Arc::new(AtomicBool::new(false));
         let Ok(allowed) = sched_getaffinity(Pid::from_raw(0)) else {
             return Self { stop, thread: None };
         };
-        let cores = cores_of(&allowed);
+        let cores = Cores::of(placement, allowed, adjacency);
         let flag = Arc::clone(&stop);
-        let thread = watches(placement, cores.len()).then(|| {
-            std::thread::spawn(move || {
-                super::load::watch(placement, &pids, &allowed, &cores, &flag)
-            })
+        if !cores.pinned.is_empty() {
+            place(&pids, Placed::Spread, &cores);
+        }
+        let thread = watches(placement, cores.list.len()).then(|| {
+            std::thread::spawn(move || super::load::watch(placement, &pids, &cores, &flag))
         });
         Self { stop, thread }
     }
@@ -178,21 +232,24 @@ impl Drop for Placer {
     }
 }
 
-/// Places `pids` as `placed` (`allowed`: the spread set).
-pub(super) fn place(pids: &[u32], placed: Placed, allowed: &CpuSet) {
-    let set = match placed {
-        Placed::Spread => *allowed,
-        Placed::Packed(core) => {
-            let mut one = CpuSet::new();
-            if one.set(core).is_err() {
-                return;
-            }
-            one
+/// Places `pids` as `placed` on `cores`.
+pub(super) fn place(pids: &[u32], placed: Placed, cores: &Cores) {
+    for (k, &pid) in pids.iter().enumerate() {
+        let set = match (placed, cores.pinned.get(k)) {
+            (Placed::Spread, None) => Some(cores.allowed),
+            (Placed::Spread, Some(&core)) | (Placed::Packed(core), _) => only(core),
+        };
+        if let Some(set) = set {
+            apply(pid, &set);
         }
-    };
-    for &pid in pids {
-        apply(pid, &set);
     }
+}
+
+/// The set of core `core` alone.
+fn only(core: usize) -> Option<CpuSet> {
+    let mut one = CpuSet::new();
+    one.set(core).ok()?;
+    Some(one)
 }
 
 #[cfg(test)]
@@ -243,6 +300,53 @@ mod tests {
         assert!(watches(Placement::Auto, 2));
         assert!(watches(Placement::Pack, 2));
         assert!(!watches(Placement::Spread, 2));
+        assert!(!watches(Placement::Pin, 2));
         assert!(!watches(Placement::Auto, 1));
+    }
+
+    /// A path of `n` nodes.
+    fn path(n: usize) -> Vec<Vec<usize>> {
+        (0..n)
+            .map(|i| [i.checked_sub(1), (i + 1 < n).then_some(i + 1)])
+            .map(|ws| ws.into_iter().flatten().collect())
+            .collect()
+    }
+
+    fn two_cores() -> CpuSet {
+        let mut set = CpuSet::new();
+        set.set(3).unwrap();
+        set.set(5).unwrap();
+        set
+    }
+
+    #[test]
+    fn auto_pins_a_run_with_more_nodes_than_cores_each_node_to_its_parts_core() {
+        let cores = Cores::of(Placement::Auto, two_cores(), &path(6));
+        assert_eq!(cores.list, vec![3, 5]);
+        assert_eq!(cores.pinned, vec![3, 3, 3, 5, 5, 5]);
+        // No more nodes than cores: the scheduler places them.
+        assert!(
+            Cores::of(Placement::Auto, two_cores(), &path(2))
+                .pinned
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn pin_always_pins_spread_and_pack_never_do() {
+        assert_eq!(
+            Cores::of(Placement::Pin, two_cores(), &path(2)).pinned,
+            vec![3, 5]
+        );
+        for p in [Placement::Spread, Placement::Pack] {
+            assert!(
+                Cores::of(p, two_cores(), &path(6)).pinned.is_empty(),
+                "{p:?}"
+            );
+        }
+        // One core: nothing to choose.
+        let mut one = CpuSet::new();
+        one.set(0).unwrap();
+        assert!(Cores::of(Placement::Pin, one, &path(6)).pinned.is_empty());
     }
 }

@@ -62,6 +62,8 @@ pub struct Supervisor {
     keep_groups: bool,
     /// Process ids of the nodes started.
     pids: Vec<u32>,
+    /// The node index of each of `pids`.
+    indices: Vec<usize>,
 }
 
 impl Supervisor {
@@ -82,6 +84,7 @@ impl Supervisor {
             ended: 0,
             keep_groups: false,
             pids: Vec::new(),
+            indices: Vec::new(),
         })
     }
 
@@ -89,6 +92,12 @@ impl Supervisor {
     #[must_use]
     pub fn pids(&self) -> &[u32] {
         &self.pids
+    }
+
+    /// The node index of each of [`Self::pids`].
+    #[must_use]
+    pub fn indices(&self) -> &[usize] {
+        &self.indices
     }
 
     /// Leaves the process group of a node that exits by itself alone (by
@@ -133,6 +142,7 @@ impl Supervisor {
         let spawned = cmd.spawn();
         let pid = spawned.as_ref().ok().and_then(tokio::process::Child::id);
         self.pids.extend(pid);
+        self.indices.extend(pid.map(|_| index));
         let keep_groups = self.keep_groups;
         self.rt.spawn(async move {
             let (mut child, copy) = match spawned {
