@@ -13,11 +13,15 @@
 //!   thus costs 20 ms of blocking, not a second, while a lasting competitor
 //!   is probed only about once a second.
 //! - where the orchestrator places the run ([`Contention::Placement`]) it
-//!   moves the nodes off cores that competitors use, and the waiter ignores
-//!   slow yields: with more of the run's own processes than cores a yield
-//!   comes back late on an idle machine too (100 nodes on 2 cores: 10–40
-//!   per node per second), and blocking after each made such runs 2–5×
-//!   slower than plain yielding (BENCHMARKS.md, session 6).
+//!   moves the nodes off cores that competitors use, and the waiter starts
+//!   a hold only after [`PLACED_STREAK`] stolen yields in a row: with more
+//!   of the run's own processes than cores a yield comes back late on an
+//!   idle machine too (100 nodes on 2 cores: 10–40 per node per second, one
+//!   at a time), and blocking after each made such runs 2–5× slower than
+//!   plain yielding (BENCHMARKS.md, session 6); but a competitor the
+//!   placement could not move (the run packed onto a core that a CPU-bound
+//!   program keeps) takes every yield, and yielding on to it made the paper
+//!   run 3–25× slower than its idle time (session 16).
 //!
 //! Blocking sleeps on the node's wake event in slices of [`BLOCK_SLICE`] and
 //! the caller re-polls its subscribers after every wake, timeout or not, so
@@ -40,6 +44,9 @@ pub const HOLD_MIN: Duration = Duration::from_millis(20);
 pub const HOLD_MAX: Duration = Duration::from_secs(1);
 /// Longest single sleep on the wake event.
 pub const BLOCK_SLICE: Duration = Duration::from_millis(1);
+/// Stolen yields in a row that start a hold where the orchestrator places
+/// the run ([`Contention::Placement`]); one does elsewhere.
+pub const PLACED_STREAK: u32 = 3;
 
 /// Applies a [`WaitStrategy`] between polls.
 #[derive(Debug)]
@@ -56,8 +63,10 @@ pub struct Waiter {
     probing: bool,
     /// Times a yield was stolen (adaptive), for the node's report.
     stolen: u64,
-    /// Whether a stolen yield starts a hold ([`Contention::Waiter`]).
-    holds: bool,
+    /// Stolen yields since the last clean one.
+    in_a_row: u32,
+    /// Stolen yields in a row that start a hold (1, or [`PLACED_STREAK`]).
+    streak: u32,
     /// Longest single sleep on the wake event ([`BLOCK_SLICE`]).
     slice: Duration,
 }
@@ -74,17 +83,21 @@ impl Waiter {
             hold: HOLD_MIN,
             probing: false,
             stolen: 0,
-            holds: true,
+            in_a_row: 0,
+            streak: 1,
             slice: BLOCK_SLICE,
         }
     }
 
     /// The same for a node whose competitors are handled by `contention`:
-    /// with [`Contention::Placement`] a stolen yield is counted but starts
-    /// no hold.
+    /// with [`Contention::Placement`] only [`PLACED_STREAK`] stolen yields
+    /// in a row start a hold.
     #[must_use]
     pub fn with_contention(mut self, contention: Contention) -> Self {
-        self.holds = contention == Contention::Waiter;
+        self.streak = match contention {
+            Contention::Waiter => 1,
+            Contention::Placement => PLACED_STREAK,
+        };
         self
     }
 
@@ -167,13 +180,15 @@ impl Waiter {
     }
 
     /// Records a yield from `before` to `after`: if it took longer than
-    /// [`STOLEN`], block at once for the hold (doubled if this yield was the
-    /// probe ending the previous hold); a clean probe resets the hold.
+    /// [`STOLEN`] and is the streak's last in a row, block at once for the
+    /// hold (doubled if this yield was the probe ending the previous hold); a
+    /// clean yield ends the streak, a clean probe resets the hold.
     fn after_yield(&mut self, before: Instant, after: Instant) {
         let probe = std::mem::take(&mut self.probing);
         if after.duration_since(before) > STOLEN {
             self.stolen += 1;
-            if !self.holds {
+            self.in_a_row = self.in_a_row.saturating_add(1);
+            if self.in_a_row < self.streak {
                 return;
             }
             self.hold = if probe {
@@ -182,8 +197,11 @@ impl Waiter {
                 HOLD_MIN
             };
             self.contended_until = Some(after + self.hold);
-        } else if probe {
-            self.hold = HOLD_MIN;
+        } else {
+            self.in_a_row = 0;
+            if probe {
+                self.hold = HOLD_MIN;
+            }
         }
     }
 }
@@ -273,16 +291,39 @@ mod tests {
     }
 
     #[test]
-    fn where_the_orchestrator_places_the_run_a_stolen_yield_is_counted_but_never_blocks() {
+    fn where_the_orchestrator_places_the_run_lone_stolen_yields_are_counted_but_never_block() {
         let t0 = Instant::now();
         let mut w = adaptive(t0).with_contention(Contention::Placement);
-        let back = t0 + STOLEN * 2;
-        w.after_yield(t0, back);
-        assert_eq!(w.stolen(), 1);
+        let mut at = t0;
+        // Stolen yields with clean ones between them: the run's own processes.
+        for _ in 0..10 {
+            w.after_yield(at, at + STOLEN * 2);
+            at += STOLEN * 2;
+            w.after_yield(at, at + Duration::from_micros(5));
+            at += Duration::from_micros(5);
+        }
+        assert_eq!(w.stolen(), 10);
         assert_eq!(w.contended_until, None);
-        w.began = back;
-        assert_eq!(w.adaptive_step(back), Step::Yield);
+        w.began = at;
+        assert_eq!(w.adaptive_step(at), Step::Yield);
         // The window still ends a long wait in blocking.
-        assert_eq!(w.adaptive_step(back + YIELD_WINDOW * 2), Step::Block);
+        assert_eq!(w.adaptive_step(at + YIELD_WINDOW * 2), Step::Block);
+    }
+
+    #[test]
+    fn where_the_orchestrator_places_the_run_stolen_yields_in_a_row_start_a_hold() {
+        let t0 = Instant::now();
+        let mut w = adaptive(t0).with_contention(Contention::Placement);
+        let mut at = t0;
+        for k in 1..=PLACED_STREAK {
+            w.after_yield(at, at + STOLEN * 2);
+            at += STOLEN * 2;
+            assert_eq!(w.contended_until.is_some(), k == PLACED_STREAK, "after {k}");
+        }
+        w.began = at;
+        assert_eq!(w.adaptive_step(at), Step::Block);
+        // The probe after the hold is stolen again: the hold doubles at once.
+        at += HOLD_MIN + Duration::from_millis(1);
+        assert_eq!(probe(&mut w, at, STOLEN * 2), HOLD_MIN * 2);
     }
 }

@@ -34,11 +34,21 @@ pub struct BareSpec {
     pub wait: WaitStrategy,
     /// `None`: the ring i ± 1 (fan-out 2); `Some`: this graph, with this fan-out limit.
     pub graph: Option<(Vec<NodeTopo>, usize)>,
+    /// Each node pinned to one core as `attsync run --placement pin` would
+    /// (the same cut of the graph), else left to the scheduler.
+    pub pinned: bool,
 }
 
 impl std::hash::Hash for BareSpec {
     fn hash<H: std::hash::Hasher>(&self, h: &mut H) {
-        (self.n, self.steps, wait_name(self.wait), &self.graph).hash(h);
+        (
+            self.n,
+            self.steps,
+            wait_name(self.wait),
+            &self.graph,
+            self.pinned,
+        )
+            .hash(h);
     }
 }
 
@@ -126,8 +136,14 @@ fn bare_in(
         Some((g, _)) => g.iter().map(|t| (t.id, Some(t))).collect(),
     };
     let mut group = Group::default();
+    let mut pids = Vec::new();
     for &node in &nodes {
-        group.push(node.0, spawn_node(bins, run, dir, spec, node)?);
+        let child = spawn_node(bins, run, dir, spec, node)?;
+        pids.push(child.id());
+        group.push(node.0, child);
+    }
+    if spec.pinned {
+        attsync::processes::placement::pin(&pids, &adjacency(&nodes));
     }
     let failed = |id: u32, status: std::process::ExitStatus, when: &str| BenchError::Failed {
         program: format!("ring-node {id}"),
@@ -167,6 +183,27 @@ fn bare_in(
         })?);
     }
     Ok(BareRun::of(&reports))
+}
+
+/// For each of `nodes` the positions of its neighbours (inputs and outputs).
+fn adjacency(nodes: &[(u32, Option<&NodeTopo>)]) -> Vec<Vec<usize>> {
+    let position = |id: u32| nodes.iter().position(|(i, _)| *i == id);
+    let ring = |id: u32| {
+        let n = nodes.len() as u32;
+        vec![(id + n - 1) % n, (id + 1) % n]
+    };
+    (nodes.iter())
+        .map(|&(id, topo)| {
+            let ids = topo.map_or_else(
+                || ring(id),
+                |t| t.inputs.iter().chain(&t.outputs).copied().collect(),
+            );
+            let mut ws: Vec<usize> = ids.into_iter().filter_map(position).collect();
+            ws.sort_unstable();
+            ws.dedup();
+            ws
+        })
+        .collect()
 }
 
 impl BareRun {

@@ -149,6 +149,15 @@ impl Case {
             steps: self.steps,
             wait: WaitStrategy::Adaptive,
             graph: Some((self.topo.clone(), self.max_fanout)),
+            pinned: false,
+        }
+    }
+
+    /// The same, each node pinned to one core as attsync's placement pins a run.
+    pub fn pinned_graph_spec(&self) -> BareSpec {
+        BareSpec {
+            pinned: true,
+            ..self.graph_spec()
         }
     }
 }
@@ -209,6 +218,7 @@ pub(super) fn ring_spec(n: u32, steps: u64, wait: WaitStrategy) -> BareSpec {
         steps,
         wait,
         graph: None,
+        pinned: false,
     }
 }
 

@@ -253,9 +253,9 @@ fn diagnostics(w: &mut String, res: &Results, notes: &mut Vec<String>) {
     );
     let _ = writeln!(
         w,
-        "| case | nodes | steps | bare ring | bare, scenario's graph | attsync, telemetry off | attsync | in-process engine, all nodes in one thread |"
+        "| case | nodes | steps | bare ring | bare, scenario's graph | bare, scenario's graph, pinned | attsync, telemetry off | attsync | in-process engine, all nodes in one thread |"
     );
-    let _ = writeln!(w, "|---|---:|---:|---:|---:|---:|---:|---:|");
+    let _ = writeln!(w, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for d in &res.diag {
         let c = &res.cases[d.case];
         let ring = res
@@ -263,6 +263,7 @@ fn diagnostics(w: &mut String, res: &Results, notes: &mut Vec<String>) {
             .get(&ring_spec(c.nodes, c.steps, WaitStrategy::Adaptive))
             .and_then(|b| b.span);
         let graph = res.bare.get(&d.graph).cloned().unwrap_or_default();
+        let pinned = res.bare.get(&d.pinned).cloned().unwrap_or_default();
         let att = res
             .procs
             .iter()
@@ -271,25 +272,29 @@ fn diagnostics(w: &mut String, res: &Results, notes: &mut Vec<String>) {
         let inproc = res.inproc[d.case].run_seconds;
         let _ = writeln!(
             w,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             c.label,
             c.nodes,
             c.steps,
             f(us_per_exchange(c.steps, ring), 1),
             f(us_per_exchange(c.steps, graph.span), 1),
+            f(us_per_exchange(c.steps, pinned.span), 1),
             f(us_per_exchange(c.steps, d.quiet.lockstep), 1),
             f(us_per_exchange(c.steps, att), 1),
             f(us_per_exchange(c.steps, inproc), 2)
         );
         let same_graph = format!("{} same-graph bare", c.label);
         failures(&same_graph, &graph.errors, graph.ok, notes);
+        let pinned_graph = format!("{} same-graph bare, pinned", c.label);
+        failures(&pinned_graph, &pinned.errors, pinned.ok, notes);
         let quiet = format!("{} telemetry off", c.label);
         failures(&quiet, &d.quiet.errors, d.quiet.ok, notes);
     }
     let _ = writeln!(
         w,
         "\n\"bare, scenario's graph\": `ring-node` processes wired like the scenario (each node's inputs and receivers as \
-         the process engine wires them, the leader with no inputs), no model. \"telemetry off\": \
+         the process engine wires them, the leader with no inputs), no model; \"pinned\": each of them pinned to one \
+         core as `attsync run` pins a run with more nodes than cores (`--placement pin`). \"telemetry off\": \
          `--set output.sample_period=<duration>` (telemetry only at the first and last step)."
     );
 }

@@ -116,6 +116,7 @@ pub(super) struct ProcRow {
 pub(super) struct DiagRow {
     pub case: usize,
     pub graph: BareSpec,
+    pub pinned: BareSpec,
     pub quiet: Agg,
 }
 
@@ -337,22 +338,28 @@ impl<'a> Runner<'a> {
         }
     }
 
-    /// Diagnostics (adaptive): the scenario's graph without the model, and
-    /// attsync with telemetry only at the first and last step.
+    /// Diagnostics (adaptive): the scenario's graph without the model (left
+    /// to the scheduler, and pinned like attsync's placement), and attsync
+    /// with telemetry only at the first and last step.
     fn diagnostics(&mut self, res: &mut Results, ci: usize, plan: &Plan) {
         let case = res.cases[ci].clone();
         let graph = case.graph_spec();
+        let pinned = case.pinned_graph_spec();
         let quiet = self.attsync_reps(
             &case,
             Engine::Processes(WaitStrategy::Adaptive),
             &case.quiet_sets(),
             "processes adaptive, telemetry off,",
             plan.reps,
-            |r, k| r.bare_rep(res, &graph, k, "same-graph bare lockstep"),
+            |r, k| {
+                r.bare_rep(res, &graph, k, "same-graph bare lockstep");
+                r.bare_rep(res, &pinned, k, "same-graph bare lockstep, pinned,");
+            },
         );
         res.diag.push(DiagRow {
             case: ci,
             graph,
+            pinned,
             quiet,
         });
     }

@@ -30,7 +30,7 @@ mod configs;
 mod load;
 pub mod namespace;
 pub mod node_log;
-mod partition;
+pub mod partition;
 pub mod placement;
 pub mod ports;
 pub mod reaper;

@@ -59,7 +59,7 @@ pub const HYSTERESIS: u32 = 2;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Placed {
     /// Every allowed core (each node on its part's core, if the run is
-    /// partitioned: [`Cores::pinned`]).
+    /// partitioned: see `Cores::of`).
     Spread,
     /// This core.
     Packed(usize),
@@ -228,6 +228,18 @@ impl Drop for Placer {
         self.stop.store(true, Ordering::Relaxed);
         if let Some(t) = self.thread.take() {
             let _ = t.join();
+        }
+    }
+}
+
+/// Pins each of `pids` to its part's core as `--placement pin` does
+/// (`adjacency[k]`: the positions in `pids` of node `k`'s neighbours); for
+/// the benchmark's bare lockstep, placed like a run.
+pub fn pin(pids: &[u32], adjacency: &[Vec<usize>]) {
+    if let Ok(allowed) = sched_getaffinity(Pid::from_raw(0)) {
+        let cores = Cores::of(Placement::Pin, allowed, adjacency);
+        if !cores.pinned.is_empty() {
+            place(pids, Placed::Spread, &cores);
         }
     }
 }
