@@ -6,8 +6,13 @@
 //! here with as many CPU-bound competitors as cores. The placement never
 //! changes what a node computes: results are byte-identical.
 //!
+//! Packed, every thread of every node asks for short time slices
+//! (`attsync_sched::SHORT_SLICE`, Linux ≥ 6.12); spread, the kernel's
+//! default.
+//!
 //! The test reads each node's allowed CPUs from `/proc/<pid>/status`
-//! (`Cpus_allowed_list`) while the run steps; every wait is bounded.
+//! (`Cpus_allowed_list`) and its time slice from `/proc/<pid>/sched`
+//! (`se.slice`, ns) while the run steps; every wait is bounded.
 
 use attsync_tests::{
     Attsync, Sandbox, assert_same_results, node_pid, owned_runs, paper, run_args, wait_until,
@@ -22,33 +27,72 @@ fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
 }
 
-/// The CPUs node `id` of `run` may run on, as `/proc` lists them ("0-1", "1").
-fn allowed(run: &str, id: u32) -> Option<String> {
+/// Where a node may run and the time slice it asked for.
+#[derive(Debug)]
+struct Placed {
+    /// The CPUs it may run on, as `/proc` lists them ("0-1", "1").
+    cpus: String,
+    /// Its time slice, ns (`None` where the kernel does not say).
+    slice_ns: Option<u64>,
+}
+
+/// Where node `id` of `run` may run, and its slice.
+fn placed(run: &str, id: u32) -> Option<Placed> {
     let pid = node_pid(run, id)?;
     let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
-    status
+    let cpus = status
         .lines()
         .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))
-        .map(|s| s.trim().to_string())
+        .map(|s| s.trim().to_string())?;
+    let sched = std::fs::read_to_string(format!("/proc/{pid}/sched")).ok()?;
+    let slice_ns = sched.lines().find_map(|l| {
+        l.strip_prefix("se.slice")?
+            .split(':')
+            .nth(1)?
+            .trim()
+            .parse()
+            .ok()
+    });
+    Some(Placed { cpus, slice_ns })
 }
 
 /// The paper run's nodes: the leader and 7 agents.
 const NODES: u32 = 8;
 
-/// The CPUs every node of `run` may run on, if every node is there.
-fn allowed_all(run: &str) -> Option<Vec<String>> {
-    (0..NODES).map(|id| allowed(run, id)).collect()
+/// Where every node of `run` may run, if every node is there.
+fn placed_all(run: &str) -> Option<Vec<Placed>> {
+    (0..NODES).map(|id| placed(run, id)).collect()
+}
+
+/// Whether this kernel has custom time slices (Linux ≥ 6.12).
+fn custom_slices() -> bool {
+    let release = std::fs::read_to_string("/proc/sys/kernel/osrelease").unwrap_or_default();
+    let mut v = release.split(|c: char| !c.is_ascii_digit());
+    let mut next = || v.next().and_then(|x| x.parse::<u32>().ok()).unwrap_or(0);
+    (next(), next()) >= (6, 12)
+}
+
+/// Every node asked for short slices (where the kernel has them).
+fn short_slices(nodes: &[Placed]) -> bool {
+    let short = u64::try_from(attsync_sched::SHORT_SLICE.as_nanos()).expect("ns");
+    !custom_slices() || nodes.iter().all(|n| n.slice_ns == Some(short))
+}
+
+/// No node asked for short slices.
+fn default_slices(nodes: &[Placed]) -> bool {
+    let short = u64::try_from(attsync_sched::SHORT_SLICE.as_nanos()).expect("ns");
+    nodes.iter().all(|n| n.slice_ns != Some(short))
 }
 
 /// Runs the paper's scheme-1 scenario for `duration` s with `args`, and
-/// waits (bounded) until `seen(allowed CPUs of each node)` holds while it
+/// waits (bounded) until `seen(where each node may run)` holds while it
 /// steps. Returns whether it was seen; the run is waited for and must succeed.
 fn run_and_watch(
     sb: &Sandbox,
     out: &str,
     duration: &str,
     args: &[&str],
-    seen: impl Fn(&[String]) -> bool,
+    seen: impl Fn(&[Placed]) -> bool,
 ) -> bool {
     let set = format!("simulation.duration={duration}");
     let running = Attsync::new(sb.path())
@@ -66,7 +110,7 @@ fn run_and_watch(
     })
     .expect("the run's namespace");
     let hit = wait_until(Duration::from_secs(60), POLL, || {
-        allowed_all(&run).filter(|a| seen(a)).map(|_| ())
+        placed_all(&run).filter(|a| seen(a)).map(|_| ())
     })
     .is_some();
     running
@@ -80,14 +124,19 @@ fn single_core(list: &str) -> bool {
     !list.contains('-') && !list.contains(',')
 }
 
-/// Every node on one and the same core.
-fn packed(lists: &[String]) -> bool {
-    lists.iter().all(|l| single_core(l)) && lists.iter().all(|l| *l == lists[0])
+/// Every node on one and the same core, with short slices.
+fn packed(nodes: &[Placed]) -> bool {
+    nodes.iter().all(|n| single_core(&n.cpus))
+        && nodes.iter().all(|n| n.cpus == nodes[0].cpus)
+        && short_slices(nodes)
 }
 
-/// Every node on a single core, the nodes over more than one core.
-fn pinned_apart(lists: &[String]) -> bool {
-    lists.iter().all(|l| single_core(l)) && lists.iter().any(|l| *l != lists[0])
+/// Every node on a single core, the nodes over more than one core, with
+/// the kernel's slices.
+fn pinned_apart(nodes: &[Placed]) -> bool {
+    nodes.iter().all(|n| single_core(&n.cpus))
+        && nodes.iter().any(|n| n.cpus != nodes[0].cpus)
+        && default_slices(nodes)
 }
 
 /// CPU-bound competitors, killed when dropped.
@@ -127,14 +176,14 @@ fn pack_puts_every_node_on_one_core_and_changes_no_result() {
     let was_packed = run_and_watch(&sb, "packed", "20", &["--placement", "pack"], packed);
     assert!(
         was_packed,
-        "the nodes never ran on one core with --placement pack"
+        "the nodes never ran on one core with short slices with --placement pack"
     );
     let spread = run_and_watch(&sb, "spread", "20", &["--placement", "spread"], |a| {
-        a.iter().all(|l| !single_core(l))
+        a.iter().all(|n| !single_core(&n.cpus)) && default_slices(a)
     });
     assert!(
         spread,
-        "a node ran on a single core with --placement spread"
+        "with --placement spread a node ran on a single core or with short slices"
     );
     assert_same_results(&sb.join("packed"), &sb.join("spread"));
 }

@@ -117,12 +117,16 @@ pub fn least_busy(w: &Window) -> Option<usize> {
         .map(|&(core, _)| core)
 }
 
-/// Moves every thread of `pid` onto `set` (threads started later inherit it).
-fn apply(pid: u32, set: &CpuSet) {
+/// Moves every thread of `pid` onto `set` with time slices of `slice`
+/// (`None`: the kernel's default); threads started later inherit both.
+fn apply(pid: u32, set: &CpuSet, slice: Option<Duration>) {
     let tasks = std::fs::read_dir(format!("/proc/{pid}/task"));
     for t in tasks.into_iter().flatten().flatten() {
         if let Some(tid) = t.file_name().to_str().and_then(|s| s.parse().ok()) {
             let _ = sched_setaffinity(Pid::from_raw(tid), set);
+            if let Err(e) = attsync_sched::set_slice(tid, slice) {
+                tracing::debug!(pid, tid, "time slice unchanged: {e}");
+            }
         }
     }
 }
@@ -244,7 +248,8 @@ pub fn pin(pids: &[u32], adjacency: &[Vec<usize>]) {
     }
 }
 
-/// Places `pids` as `placed` on `cores`.
+/// Places `pids` as `placed` on `cores`: packed, every thread also gets
+/// short time slices ([`slice`]), spread the kernel's default again.
 pub(super) fn place(pids: &[u32], placed: Placed, cores: &Cores) {
     for (k, &pid) in pids.iter().enumerate() {
         let set = match (placed, cores.pinned.get(k)) {
@@ -252,8 +257,22 @@ pub(super) fn place(pids: &[u32], placed: Placed, cores: &Cores) {
             (Placed::Spread, Some(&core)) | (Placed::Packed(core), _) => only(core),
         };
         if let Some(set) = set {
-            apply(pid, &set);
+            apply(pid, &set, slice(placed));
         }
+    }
+}
+
+/// The time slice of a node placed as `placed`: packed onto a core that a
+/// competitor may share, the shortest the kernel grants
+/// ([`attsync_sched::SHORT_SLICE`]), so that a node whose input has come
+/// runs within microseconds instead of after the competitor's slice, and a
+/// yield hands the competitor a tenth of what it did (BENCHMARKS.md, "Under
+/// contention"); spread, the kernel's default.
+#[must_use]
+pub fn slice(placed: Placed) -> Option<Duration> {
+    match placed {
+        Placed::Packed(_) => Some(attsync_sched::SHORT_SLICE),
+        Placed::Spread => None,
     }
 }
 
