@@ -13,7 +13,8 @@
 //! BENCHMARKS.md "Under contention").
 //!
 //! The orchestrator asks this for every thread of every node process
-//! ([`set_process_slice`]), plug-ins included, while it packs the run onto
+//! ([`set_slice`], beside each thread's CPU affinity), plug-ins included,
+//! while it packs the run onto
 //! one core because other programs keep the machine busy, and gives them
 //! back the kernel's default when it spreads the run again; the policy and
 //! nice value of each thread are kept. On an older kernel the request is
