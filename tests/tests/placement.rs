@@ -3,8 +3,7 @@
 //! node to one core (the graph cut into a part per core), `auto` (the
 //! default) pins like `pin` while the machine is idle (unit tests:
 //! `placement::tests`) and packs while other programs keep it busy — tested
-//! here with as many CPU-bound competitors as cores, and pins again once
-//! they are gone. The placement never
+//! here with as many CPU-bound competitors as cores. The placement never
 //! changes what a node computes: results are byte-identical.
 //!
 //! Packed, every thread of every node asks for short time slices
@@ -23,15 +22,6 @@ use std::process::{Child, Command};
 use std::time::Duration;
 
 const POLL: Duration = Duration::from_millis(10);
-
-/// The tests of this file one at a time: one test's run is another's
-/// competitor (`auto` would not spread again beside it).
-fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
-    static MACHINE: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    MACHINE
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
-}
 
 fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
@@ -74,18 +64,10 @@ fn placed_all(run: &str) -> Option<Vec<Placed>> {
     (0..NODES).map(|id| placed(run, id)).collect()
 }
 
-/// Whether this kernel has custom time slices (Linux ≥ 6.12).
-fn custom_slices() -> bool {
-    let release = std::fs::read_to_string("/proc/sys/kernel/osrelease").unwrap_or_default();
-    let mut v = release.split(|c: char| !c.is_ascii_digit());
-    let mut next = || v.next().and_then(|x| x.parse::<u32>().ok()).unwrap_or(0);
-    (next(), next()) >= (6, 12)
-}
-
 /// Every node asked for short slices (where the kernel has them).
 fn short_slices(nodes: &[Placed]) -> bool {
     let short = u64::try_from(attsync_sched::SHORT_SLICE.as_nanos()).expect("ns");
-    !custom_slices() || nodes.iter().all(|n| n.slice_ns == Some(short))
+    !attsync_sched::custom_slices() || nodes.iter().all(|n| n.slice_ns == Some(short))
 }
 
 /// No node asked for short slices.
@@ -104,23 +86,6 @@ fn run_and_watch(
     args: &[&str],
     seen: impl Fn(&[Placed]) -> bool,
 ) -> bool {
-    let phases: Vec<Phase<'_>> = vec![(&seen, Box::new(|| ()))];
-    run_and_watch_phases(sb, out, duration, args, phases) == 1
-}
-
-/// What a phase waits to see, and what is done once it is seen.
-type Phase<'a> = (&'a dyn Fn(&[Placed]) -> bool, Box<dyn FnOnce() + 'a>);
-
-/// As [`run_and_watch`], for phases in turn: waits (bounded) until the
-/// first one's condition holds, does its action, then the next one's.
-/// Returns how many phases were seen while the run stepped.
-fn run_and_watch_phases(
-    sb: &Sandbox,
-    out: &str,
-    duration: &str,
-    args: &[&str],
-    phases: Vec<Phase<'_>>,
-) -> usize {
     let set = format!("simulation.duration={duration}");
     let running = Attsync::new(sb.path())
         .args(run_args(
@@ -136,22 +101,15 @@ fn run_and_watch_phases(
         owned_runs(pid).into_iter().next()
     })
     .expect("the run's namespace");
-    let mut seen = 0;
-    for (holds, then) in phases {
-        let hit = wait_until(Duration::from_secs(60), POLL, || {
-            placed_all(&run).filter(|a| holds(a)).map(|_| ())
-        });
-        if hit.is_none() {
-            break;
-        }
-        then();
-        seen += 1;
-    }
+    let hit = wait_until(Duration::from_secs(60), POLL, || {
+        placed_all(&run).filter(|a| seen(a)).map(|_| ())
+    })
+    .is_some();
     running
         .wait(attsync_tests::RUN_TIMEOUT)
         .assert_ok()
         .assert_no_leftovers();
-    seen
+    hit
 }
 
 fn single_core(list: &str) -> bool {
@@ -202,7 +160,6 @@ impl Drop for Burners {
 
 #[test]
 fn pack_puts_every_node_on_one_core_and_changes_no_result() {
-    let _machine = one_at_a_time();
     if cores() < 2 {
         eprintln!("one core: packing and spreading are the same here");
         return;
@@ -225,7 +182,6 @@ fn pack_puts_every_node_on_one_core_and_changes_no_result() {
 
 #[test]
 fn pin_puts_each_node_on_one_core_of_several_and_changes_no_result() {
-    let _machine = one_at_a_time();
     if cores() < 2 {
         eprintln!("one core: nothing to pin apart");
         return;
@@ -242,31 +198,19 @@ fn pin_puts_each_node_on_one_core_of_several_and_changes_no_result() {
 }
 
 #[test]
-fn auto_packs_while_competitors_keep_every_core_busy_and_spreads_once_they_are_gone() {
-    let _machine = one_at_a_time();
+fn auto_packs_while_competitors_keep_every_core_busy() {
     if cores() < 2 {
         eprintln!("one core: nothing to pack");
         return;
     }
     let sb = Sandbox::new("placement-auto");
-    let burners = std::cell::RefCell::new(Some(Burners::start(cores())));
-    let pinned = |a: &[Placed]| pinned_apart(a);
-    let phases: Vec<Phase<'_>> = vec![
-        (&packed, Box::new(|| drop(burners.borrow_mut().take()))),
-        (&pinned, Box::new(|| ())),
-    ];
-    // 200 s simulated: long enough to be seen spread again (the paper run
-    // does some 20 s of simulated time per second idle).
-    let seen = run_and_watch_phases(&sb, "auto", "200", &[], phases);
+    let burners = Burners::start(cores());
+    let was_packed = run_and_watch(&sb, "auto", "10", &[], packed);
     drop(burners);
     assert!(
-        seen >= 1,
-        "with {} competitors the nodes were never packed with short slices",
+        was_packed,
+        "with {} competitors the nodes were never packed",
         cores()
-    );
-    assert_eq!(
-        seen, 2,
-        "once the competitors were gone the nodes were never each on their part's core with the kernel's slices"
     );
     assert!(Path::new(&sb.join("auto/errors.csv")).is_file());
 }

@@ -343,6 +343,38 @@ mod tests {
             .collect()
     }
 
+    /// The CPUs process `pid` may run on, and its slice.
+    fn placed(pid: u32) -> (Vec<usize>, Option<Duration>) {
+        let tid = i32::try_from(pid).expect("pid");
+        let set = sched_getaffinity(Pid::from_raw(tid)).expect("affinity");
+        (cores_of(&set), attsync_sched::slice_of(tid).expect("slice"))
+    }
+
+    #[test]
+    fn packed_a_node_gets_one_core_and_short_slices_spread_every_core_and_the_default_again() {
+        let allowed = sched_getaffinity(Pid::from_raw(0)).expect("affinity");
+        let cores = Cores::of(Placement::Auto, allowed, &[Vec::new()]);
+        let mut node = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .expect("sleep");
+        let pid = node.id();
+        let (all, default) = placed(pid);
+        place(&[pid], Placed::Packed(all[0]), &cores);
+        let packed = placed(pid);
+        place(&[pid], Placed::Spread, &cores);
+        let spread = placed(pid);
+        let _ = node.kill();
+        let _ = node.wait();
+        let short = if attsync_sched::custom_slices() {
+            Some(attsync_sched::SHORT_SLICE)
+        } else {
+            default
+        };
+        assert_eq!(packed, (vec![all[0]], short));
+        assert_eq!(spread, (all, default));
+    }
+
     fn two_cores() -> CpuSet {
         let mut set = CpuSet::new();
         set.set(3).unwrap();
