@@ -153,28 +153,6 @@ pub fn set_slice(tid: i32, slice: Option<Duration>) -> Result<(), SliceError> {
     Ok(())
 }
 
-/// [`set_slice`] for every thread of process `pid`; returns how many
-/// threads now have `slice`. A thread that ends meanwhile is skipped; the
-/// first other failure is returned.
-pub fn set_process_slice(pid: u32, slice: Option<Duration>) -> Result<usize, SliceError> {
-    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
-        return Ok(0);
-    };
-    let mut set = 0;
-    for tid in tasks
-        .flatten()
-        .filter_map(|t| t.file_name().to_str()?.parse::<i32>().ok())
-    {
-        match set_slice(tid, slice) {
-            Ok(()) => set += 1,
-            Err(SliceError::Get { source, .. } | SliceError::Set { source, .. })
-                if source.raw_os_error() == Some(libc::ESRCH) => {}
-            Err(e) => return Err(e),
-        }
-    }
-    Ok(set)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -197,7 +175,6 @@ mod tests {
     #[test]
     fn a_thread_gets_the_slice_it_asks_for_keeps_its_nice_value_and_can_go_back() {
         if !kernel_has_custom_slices() {
-            eprintln!("this kernel has no custom slices (Linux < 6.12): nothing to check");
             return;
         }
         let (nice_before, slice, nice_after, default) = on_a_thread(|| {
@@ -223,7 +200,7 @@ mod tests {
     }
 
     #[test]
-    fn every_thread_of_a_process_gets_the_slice_and_its_new_threads_inherit_it() {
+    fn another_processs_thread_gets_the_slice_and_new_threads_inherit_it() {
         if !kernel_has_custom_slices() {
             return;
         }
@@ -231,12 +208,12 @@ mod tests {
             .arg("30")
             .spawn()
             .expect("sleep");
-        let set = set_process_slice(child.id(), Some(SHORT_SLICE));
         let tid = i32::try_from(child.id()).expect("pid");
+        let set = set_slice(tid, Some(SHORT_SLICE));
         let slice = slice_of(tid);
         let _ = child.kill();
         let _ = child.wait();
-        assert_eq!(set.expect("set"), 1);
+        set.expect("set");
         assert_eq!(slice.expect("slice"), Some(SHORT_SLICE));
         // Threads inherit it.
         let inherited = on_a_thread(|| {
@@ -247,10 +224,15 @@ mod tests {
     }
 
     #[test]
-    fn a_process_that_is_gone_is_no_error_and_has_no_threads() {
+    fn a_thread_that_is_gone_is_named_with_the_systems_reason() {
         let mut child = std::process::Command::new("true").spawn().expect("true");
-        let pid = child.id();
+        let tid = i32::try_from(child.id()).expect("pid");
         child.wait().expect("wait");
-        assert_eq!(set_process_slice(pid, Some(SHORT_SLICE)).expect("gone"), 0);
+        match set_slice(tid, Some(SHORT_SLICE)) {
+            Err(SliceError::Get { tid: t, source }) => {
+                assert_eq!((t, source.raw_os_error()), (tid, Some(libc::ESRCH)));
+            }
+            other => panic!("expected ESRCH from sched_getattr, got {other:?}"),
+        }
     }
 }

@@ -266,10 +266,9 @@ pub(super) fn place(pids: &[u32], placed: Placed, cores: &Cores) {
 /// competitor may share, the shortest the kernel grants
 /// ([`attsync_sched::SHORT_SLICE`]), so that a node whose input has come
 /// runs within microseconds instead of after the competitor's slice, and a
-/// yield hands the competitor a tenth of what it did (BENCHMARKS.md, "Under
-/// contention"); spread, the kernel's default.
-#[must_use]
-pub fn slice(placed: Placed) -> Option<Duration> {
+/// yield hands the competitor a fourteenth of what it did (docs/waiting.md,
+/// "Short slices"); spread, the kernel's default.
+fn slice(placed: Placed) -> Option<Duration> {
     match placed {
         Placed::Packed(_) => Some(attsync_sched::SHORT_SLICE),
         Placed::Spread => None,
