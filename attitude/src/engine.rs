@@ -132,6 +132,24 @@ impl InProcess {
         self.step
     }
 
+    /// The horizon, in steps ([`Network::steps`] until [`Self::extend_to`]).
+    #[must_use]
+    pub fn horizon(&self) -> u64 {
+        self.net.steps
+    }
+
+    /// Moves the horizon to `steps` (at least the steps done), so that the
+    /// next [`Self::run_until`] goes on from where the last one stopped:
+    /// what `--until settled` does. The state, the held values and the
+    /// links carry over; a run extended at a step that is a multiple of
+    /// `sample_every` is bit-identical, sample for sample, to a run given
+    /// the longer horizon from the start (the only sample a horizon adds
+    /// is its last step's).
+    pub fn extend_to(&mut self, steps: u64) {
+        assert!(steps >= self.step, "a horizon before the steps done");
+        self.net.steps = steps;
+    }
+
     /// The nodes' agents (for peak torques and models).
     #[must_use]
     pub fn agents(&self) -> &[Agent] {

@@ -27,6 +27,7 @@
 //! - [`checks`]: the paper's conditions on gains and on `P`.
 //! - [`stiffness`]: the fastest linear modes of each loop and RK4's largest stable `dt`.
 //! - [`spectrum`]: extremes of `Ξ + LLᵀ` and Appendix `appenD`'s `F ≻ 0`, sparse (no dense matrix).
+//! - [`linear`]: the closed loop linearised with communication delays: rightmost characteristic roots, exact delay margin.
 //! - [`sparse`]: sparse symmetric `LDLᵀ` / block Cholesky in a minimum-degree order (no fill-in on a forest).
 
 pub mod agent;
@@ -36,6 +37,7 @@ pub mod control;
 pub mod engine;
 pub mod guard;
 pub mod integrate;
+pub mod linear;
 pub mod link;
 pub mod metrics;
 pub mod network;

@@ -845,3 +845,47 @@ fn untrusted_values_are_refused_counted_and_change_nothing() {
     assert!(b.link_stats().is_empty());
     assert!(good.trust().is_ok() && nan.trust().is_err() && skew.trust().is_err());
 }
+
+/// `--until settled` extends a run's horizon in chunks
+/// (`InProcess::extend_to`): a run extended at steps that are multiples of
+/// `sample_every` is the run given the longer horizon from the start, bit
+/// for bit and sample for sample — on one thread and on several, with
+/// delayed links (whose held values and queues must carry over).
+#[test]
+fn a_run_extended_in_chunks_is_the_longer_run_bit_for_bit() {
+    let links = Links {
+        l01: delay_link(5, None),
+        l21: delay_link(3, None),
+        l12: delay_link(1, None),
+        l32: delay_link(7, None),
+        l23: delay_link(2, None),
+    };
+    for observerless in [true, false] {
+        for threads in [1, 3] {
+            let mut net = network(observerless, links, 300);
+            net.sample_every = 20;
+            let record = |engine: &mut InProcess, out: &mut Trajectory| {
+                engine.run(|snap| {
+                    out.push(snap.agents.iter().map(bits).collect());
+                    true
+                })
+            };
+            let mut whole = Vec::new();
+            let mut once = InProcess::new(&net).with_exact_threads(threads);
+            assert!(record(&mut once, &mut whole).is_none());
+            let mut chunked = Vec::new();
+            net.steps = 100;
+            let mut engine = InProcess::new(&net).with_exact_threads(threads);
+            for horizon in [100, 160, 300] {
+                engine.extend_to(horizon);
+                assert!(record(&mut engine, &mut chunked).is_none());
+                assert_eq!(engine.step_index(), horizon);
+            }
+            assert_eq!(whole.len(), 300 / 20 + 1);
+            assert_eq!(
+                chunked, whole,
+                "observerless = {observerless}, threads = {threads}"
+            );
+        }
+    }
+}

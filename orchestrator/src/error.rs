@@ -78,6 +78,9 @@ pub enum Error {
     /// A run directory's `view.html` could not be made (`attsync view`).
     #[error(transparent)]
     View(#[from] crate::view::ViewError),
+    /// `attsync margin`: the scenario cannot be linearised.
+    #[error(transparent)]
+    Margin(#[from] crate::margin::MarginError),
 }
 
 impl Error {
@@ -85,7 +88,7 @@ impl Error {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Scenario(_) | Error::Hosts(_) | Error::Options(_) => 2,
+            Error::Scenario(_) | Error::Hosts(_) | Error::Options(_) | Error::Margin(_) => 2,
             Error::Run(e) => run_code(e),
             Error::RunEnd(RunEnd::Interrupted(signal)) => crate::interrupt::exit_code(*signal),
             Error::RunEnd(RunEnd::Diverged(_)) => DIVERGED,
@@ -109,6 +112,7 @@ impl Error {
         matches!(
             self,
             Error::Scenario(_)
+                | Error::Margin(_)
                 | Error::Hosts(_)
                 | Error::Run(RunError::Hosts(_))
                 | Error::Sweep(SweepError::Scenario(_))

@@ -8,10 +8,13 @@
 //! - [`processes`]: the process-per-agent engine, phase by phase; the orchestrator's ports.
 //! - [`results`]: `errors.csv`, `summary.json`, `errors.svg`, atomic output.
 //! - [`sweep`]: one field over many values, and the bisection for the margin.
+//! - [`until`]: `--tolerance` and `--until settled`: what a run is judged by
+//!   (its verdict, `attsync_verdict`) and how long it goes.
 //! - [`generate`]: generated scenarios (random trees).
 //! - [`hosts`]: placement files (`--hosts HOSTS.toml`): which machine runs
 //!   which node, and the cut edges between machines (issue 12).
 //! - [`mc`]: the Monte Carlo over initial conditions (`attsync mc`).
+//! - [`margin`]: `attsync margin`, the linearisation's delay margin and rightmost root.
 //! - [`conform`]: the conformance check of a plug-in agent program.
 //! - [`verify`]: `attsync verify`, a run's files against its `manifest.json`
 //!   and a re-run of its scenario against its `states.bin` and `errors.csv`.
@@ -32,6 +35,7 @@ pub mod export;
 pub mod generate;
 pub mod hosts;
 pub mod interrupt;
+pub mod margin;
 pub mod mc;
 pub mod options;
 pub mod outcome;
@@ -41,6 +45,7 @@ pub mod results;
 pub mod run;
 pub mod scenario;
 pub mod sweep;
+pub mod until;
 pub mod verify;
 pub mod view;
 

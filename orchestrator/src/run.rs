@@ -12,6 +12,8 @@ use crate::results::manifest::{Manifest, Seeds};
 use crate::results::summary::{Diverged, LinkSummary, NodeSummary};
 use crate::results::{self, Recorder, Series, Summary, WriteError, plot, staging::Staging};
 use crate::scenario::Loaded;
+pub use crate::until::Judging;
+use crate::until::{self, Stopped, Until, UntilSummary};
 use crate::view;
 use attitude::engine::InProcess;
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
@@ -59,6 +61,8 @@ pub struct RunOptions {
     /// `--hosts`: the machines the nodes are spread over (`None`: all on
     /// this one). Placed on the scenario before anything starts.
     pub hosts: Option<Hosts>,
+    /// `--tolerance` and `--until`: what the run is judged by and how long it goes.
+    pub judging: Judging,
 }
 
 /// The default `--threads`: the number of cores (1 if unknown).
@@ -77,6 +81,7 @@ impl RunOptions {
         options::seconds("--stage-timeout", self.processes.stage_timeout)?;
         options::seconds("--start-timeout", self.processes.start_timeout)?;
         options::threads(self.threads)?;
+        self.judging.validate()?;
         if let Some(f) = self.processes.realtime {
             options::realtime(f)?;
         }
@@ -165,9 +170,32 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let text = toml::to_string(&loaded.document).expect("a TOML table serialises");
     std::fs::write(layout.scenario(), &text).map_err(io_at(&layout.scenario()))?;
     let started = Instant::now();
-    let (outcome, series, threads, frames) = drive(loaded, opts, &layout, interrupt)?;
+    let driven = drive(loaded, opts, &layout, interrupt)?;
     let wall_seconds = started.elapsed().as_secs_f64();
-    let mut summary = summarise(loaded, opts, outcome, &series, wall_seconds);
+    let text = match &driven.judged.until {
+        // The results are those of the scenario run to the final horizon:
+        // say so in its scenario.toml (what `verify` re-runs).
+        Some(u) if driven.judged.horizon != loaded.resolved.network.steps => {
+            let t = crate::results::fmt_time(driven.judged.horizon, loaded.resolved.network.dt);
+            let text = loaded.document.with_set(format!("simulation.duration={t}"));
+            let text = toml::to_string(&text).expect("a TOML table serialises");
+            std::fs::write(layout.scenario(), &text).map_err(io_at(&layout.scenario()))?;
+            tracing::debug!(
+                duration = u.duration,
+                "run: scenario.toml at the final horizon"
+            );
+            text
+        }
+        _ => text,
+    };
+    let Driven {
+        outcome,
+        series,
+        threads,
+        frames,
+        judged,
+    } = driven;
+    let mut summary = summarise(loaded, opts, outcome, &series, judged, wall_seconds);
     summary.threads = threads;
     if let Some(frames) = frames {
         let data = view::view_data(&loaded.resolved.network, view::run_info(&summary), frames);
@@ -181,8 +209,24 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
 }
 
 /// What [`drive`] recorded: how the run ended, the series, the in-process
-/// engine's thread count, and the frames of `view.html` (if asked for).
-type Driven = (Outcome, Vec<Series>, Option<usize>, Option<view::Frames>);
+/// engine's thread count, the frames of `view.html` (if asked for), and
+/// how it was judged.
+struct Driven {
+    outcome: Outcome,
+    series: Vec<Series>,
+    threads: Option<usize>,
+    frames: Option<view::Frames>,
+    judged: Judged,
+}
+
+/// The verdict on a run and the horizon it ended with.
+struct Judged {
+    verdict: attsync_verdict::Verdict,
+    /// The horizon, steps (the scenario's unless `--until settled` extended it).
+    horizon: u64,
+    /// `--until settled`: how it went.
+    until: Option<UntilSummary>,
+}
 
 /// `--hosts` placed on the scenario's network (checked before anything
 /// starts): the hosts and their nodes, or `None` for a run on this machine.
@@ -195,9 +239,60 @@ fn plan(loaded: &Loaded, opts: &RunOptions) -> Result<Option<crate::remote::Plan
     Ok(Some(crate::remote::Plan::of(&placement)))
 }
 
+/// Where the snapshots of one attempt go: `errors.csv`, `states.bin`, the
+/// series, the view's frames and the progress bar.
+struct Recording<'a> {
+    recorder: Recorder,
+    frames: Option<view::Collector>,
+    bar: &'a ProgressBar,
+    write_error: Option<WriteError>,
+}
+
+impl<'a> Recording<'a> {
+    /// Starts the files of a run of `net` in `layout` (again: truncated).
+    fn start(
+        loaded: &Loaded,
+        opts: &RunOptions,
+        layout: &RunLayout,
+        bar: &'a ProgressBar,
+    ) -> Result<Self, RunError> {
+        let net = &loaded.resolved.network;
+        let recorder = Recorder::new(layout.root(), &loaded.name(), net).map_err(written)?;
+        Ok(Self {
+            recorder,
+            frames: opts.view.then(|| view::Collector::new(net)),
+            bar,
+            write_error: None,
+        })
+    }
+
+    /// Records one snapshot; `false` (stop) once a file cannot be written.
+    fn record(&mut self, snap: &attitude::engine::Snapshot<'_>, rows: &[results::Row]) -> bool {
+        if let Err(e) = self.recorder.record_rows(snap, rows) {
+            self.write_error = Some(e);
+            return false;
+        }
+        if let Some(f) = self.frames.as_mut() {
+            f.push(snap);
+        }
+        self.bar.set_position(snap.step);
+        true
+    }
+
+    /// Flushes the files: the series and the frames.
+    fn finish(self) -> Result<(Vec<Series>, Option<view::Frames>), RunError> {
+        if let Some(e) = self.write_error {
+            return Err(written(e));
+        }
+        let series = self.recorder.finish().map_err(written)?;
+        Ok((series, self.frames.map(view::Collector::finish)))
+    }
+}
+
 /// Runs the engine, recording every snapshot into `layout` (and the view's
-/// frames); how it ended (its failure naming the signal if interrupted),
-/// the recorded series and the in-process engine's thread count.
+/// frames), for as long as `opts.judging` says: how it ended (its failure
+/// naming the signal if interrupted), the recorded series, the in-process
+/// engine's thread count and the verdict.
 fn drive(
     loaded: &Loaded,
     opts: &RunOptions,
@@ -205,59 +300,15 @@ fn drive(
     interrupt: &Interrupt,
 ) -> Result<Driven, RunError> {
     let net = &loaded.resolved.network;
-    let dir = layout.root();
-    let mut recorder = Recorder::new(dir, &loaded.name(), net).map_err(written)?;
-    let mut frames = opts.view.then(|| view::Collector::new(net));
     let bar = progress_bar(opts.progress, net.steps, net.dt);
-    let mut write_error = None;
-    let row = recorder.row_maker();
-    let mut record = |snap: &attitude::engine::Snapshot<'_>, rows: &[results::Row]| {
-        if let Err(e) = recorder.record_rows(snap, rows) {
-            write_error = Some(e);
-            return false;
-        }
-        if let Some(f) = frames.as_mut() {
-            f.push(snap);
-        }
-        bar.set_position(snap.step);
-        true
-    };
-    let mut threads = None;
-    let outcome = match opts.engine {
-        Engine::InProcess => {
-            let mut engine = InProcess::new(net).with_threads(opts.threads);
-            threads = Some(engine.threads());
-            let mut interrupted = false;
-            // Each agent's row is made by the thread that steps it; the
-            // interrupt is asked every step (samples may be far apart).
-            let diverged = engine.run_until(
-                &row,
-                |snap, rows| {
-                    interrupted = interrupt.is_set();
-                    !interrupted && record(snap, rows)
-                },
-                || interrupt.is_set(),
-            );
-            let stopped = diverged.is_none() && engine.step_index() < net.steps;
-            let interrupted = interrupted || (stopped && interrupt.is_set());
-            Outcome::in_process(&engine, interrupted, diverged)
-        }
-        Engine::Processes => {
-            let mut process_opts = opts.processes.clone();
-            process_opts.plugins = loaded.resolved.plugins.clone();
-            process_opts.hosts = plan(loaded, opts)?;
-            let record =
-                |snap: &attitude::engine::Snapshot<'_>| record(snap, &results::rows_of(&row, snap));
-            processes::run(net, &process_opts, &layout.logs(), interrupt.flag(), record)?
-        }
+    let driven = match opts.engine {
+        Engine::InProcess => drive_in_process(loaded, opts, layout, interrupt, &bar)?,
+        Engine::Processes => drive_processes(loaded, opts, layout, interrupt, &bar)?,
     };
     bar.finish_and_clear();
-    if let Some(e) = write_error {
-        return Err(written(e));
-    }
-    let series = recorder.finish().map_err(written)?;
     // A diverged run says where, whichever engine ran it. An engine
     // stopped by the interrupt says "interrupted": say which signal.
+    let outcome = driven.outcome;
     let failure = match &outcome.diverged {
         Some(d) => Some(d.message(net, loaded.resolved.stiffness.as_ref())),
         None => outcome
@@ -269,8 +320,147 @@ fn drive(
                 _ => f,
             }),
     };
-    let frames = frames.map(view::Collector::finish);
-    Ok((Outcome { failure, ..outcome }, series, threads, frames))
+    let outcome = Outcome { failure, ..outcome };
+    Ok(Driven { outcome, ..driven })
+}
+
+/// The in-process engine, its horizon extended in chunks while
+/// `--until settled` asks for it ([`InProcess::extend_to`]).
+fn drive_in_process(
+    loaded: &Loaded,
+    opts: &RunOptions,
+    layout: &RunLayout,
+    interrupt: &Interrupt,
+    bar: &ProgressBar,
+) -> Result<Driven, RunError> {
+    let net = &loaded.resolved.network;
+    let mut rec = Recording::start(loaded, opts, layout, bar)?;
+    let row = rec.recorder.row_maker();
+    let mut engine = InProcess::new(net).with_threads(opts.threads);
+    let max = opts.judging.max_steps(net.steps, net.dt);
+    let (mut chunks, mut interrupted) = (0, false);
+    let (diverged, verdict) = loop {
+        chunks += 1;
+        // Each agent's row is made by the thread that steps it; the
+        // interrupt is asked every step (samples may be far apart).
+        let diverged = engine.run_until(
+            &row,
+            |snap, rows| {
+                interrupted = interrupt.is_set();
+                !interrupted && rec.record(snap, rows)
+            },
+            || interrupt.is_set(),
+        );
+        let verdict = opts.judging.verdict(rec.recorder.series());
+        let stopped = diverged.is_some() || engine.step_index() < engine.horizon();
+        if stopped || !until::goes_on(verdict.kind) || engine.horizon() >= max {
+            break (diverged, verdict);
+        }
+        engine.extend_to(until::next_horizon(engine.horizon(), max, net.sample_every));
+        bar.set_length(engine.horizon());
+    };
+    let stopped = diverged.is_none() && engine.step_index() < engine.horizon();
+    let interrupted = interrupted || (stopped && interrupt.is_set());
+    let ended = diverged.is_some() || interrupted;
+    let outcome = Outcome::in_process(&engine, interrupted, diverged);
+    let horizon = engine.horizon();
+    let (series, frames) = rec.finish()?;
+    let judged = judged(loaded, opts, verdict, horizon, chunks, ended, &outcome);
+    Ok(Driven {
+        outcome,
+        series,
+        threads: Some(engine.threads()),
+        frames,
+        judged,
+    })
+}
+
+/// The processes engine: its nodes are started for a fixed horizon, so
+/// `--until settled` runs again from t = 0 with the next horizon.
+fn drive_processes(
+    loaded: &Loaded,
+    opts: &RunOptions,
+    layout: &RunLayout,
+    interrupt: &Interrupt,
+    bar: &ProgressBar,
+) -> Result<Driven, RunError> {
+    let mut net = loaded.resolved.network.clone();
+    let max = opts.judging.max_steps(net.steps, net.dt);
+    let mut process_opts = opts.processes.clone();
+    process_opts.plugins = loaded.resolved.plugins.clone();
+    process_opts.hosts = plan(loaded, opts)?;
+    let mut chunks = 0;
+    loop {
+        chunks += 1;
+        let mut rec = Recording::start(loaded, opts, layout, bar)?;
+        let row = rec.recorder.row_maker();
+        let record =
+            |snap: &attitude::engine::Snapshot<'_>| rec.record(snap, &results::rows_of(&row, snap));
+        let outcome = processes::run(
+            &net,
+            &process_opts,
+            &layout.logs(),
+            interrupt.flag(),
+            record,
+        )?;
+        let (series, frames) = rec.finish()?;
+        let verdict = opts.judging.verdict(&series);
+        let ended = outcome.diverged.is_some() || outcome.failure.is_some();
+        if ended || !until::goes_on(verdict.kind) || net.steps >= max {
+            let judged = judged(loaded, opts, verdict, net.steps, chunks, ended, &outcome);
+            return Ok(Driven {
+                outcome,
+                series,
+                threads: None,
+                frames,
+                judged,
+            });
+        }
+        net.steps = until::next_horizon(net.steps, max, net.sample_every);
+        bar.set_length(net.steps);
+        bar.set_position(0);
+    }
+}
+
+/// The verdict of a run that ended at `horizon` after `chunks` chunks
+/// (`ended`: diverged, failed or interrupted), and the `until` record of
+/// an `--until settled` run.
+fn judged(
+    loaded: &Loaded,
+    opts: &RunOptions,
+    verdict: attsync_verdict::Verdict,
+    horizon: u64,
+    chunks: u32,
+    ended: bool,
+    outcome: &Outcome,
+) -> Judged {
+    let net = &loaded.resolved.network;
+    let verdict = match &outcome.diverged {
+        Some(d) => attsync_verdict::diverged(d.step as f64 * net.dt, opts.judging.tolerance),
+        None => verdict,
+    };
+    let until = match opts.judging.until {
+        Until::Horizon => None,
+        Until::Settled { max_duration } => Some(UntilSummary {
+            rule: "settled".into(),
+            scenario_duration: net.steps as f64 * net.dt,
+            max_duration,
+            duration: horizon as f64 * net.dt,
+            chunks,
+            stopped: if ended {
+                Stopped::RunEnded
+            } else if until::goes_on(verdict.kind) {
+                Stopped::MaxDuration
+            } else {
+                Stopped::VerdictFinal
+            },
+        }),
+    };
+    Judged {
+        verdict,
+        horizon,
+        until,
+    }
 }
 
 /// `summary.json` of a run that ended as `outcome` with `series` recorded.
@@ -279,9 +469,11 @@ fn summarise(
     opts: &RunOptions,
     outcome: Outcome,
     series: &[Series],
+    judged: Judged,
     wall_seconds: f64,
 ) -> Summary {
     let net = &loaded.resolved.network;
+    let horizon = judged.horizon;
     let mut agents = results::agent_summaries(series, &outcome.peak_torques);
     for (a, p) in agents.iter_mut().zip(&outcome.pacing) {
         if opts.processes.realtime.is_some() {
@@ -301,11 +493,11 @@ fn summarise(
         scenario: loaded.name(),
         engine: opts.engine.name().into(),
         law: loaded.scenario.scheme.law,
-        complete: outcome.failure.is_none() && outcome.diverged.is_none() && steps == net.steps,
+        complete: outcome.failure.is_none() && outcome.diverged.is_none() && steps == horizon,
         incomplete_reason: outcome.failure,
         diverged: outcome.diverged.map(|d| Diverged::of(&d, net.dt)),
         dt: net.dt,
-        duration: net.steps as f64 * net.dt,
+        duration: horizon as f64 * net.dt,
         t_end: steps as f64 * net.dt,
         steps,
         wall_seconds,
@@ -319,6 +511,8 @@ fn summarise(
             .map(|(name, id, d)| NodeSummary::of(*id, name, d))
             .collect(),
         threads: None,
+        verdict: Some(judged.verdict),
+        until: judged.until,
     }
 }
 
@@ -508,6 +702,7 @@ mod tests {
             threads: 1,
             view: false,
             hosts: None,
+            judging: Judging::default(),
         }
     }
 

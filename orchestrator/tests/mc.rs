@@ -29,7 +29,8 @@ fn trials(dir: &Path) -> Vec<Vec<String>> {
     assert_eq!(
         lines.next(),
         Some(
-            "trial,seed,outcome,final_max_att_err,final_max_angvel_err,t_end,settle_1e-3,settle_1e-6"
+            "trial,seed,outcome,decay_rate_per_s,final_max_att_err,final_max_angvel_err_rad_s,\
+             t_end_s,settle_att_1e-3_s,settle_att_1e-6_s,settle_angvel_1e-3_s,settle_angvel_1e-6_s"
         )
     );
     lines
@@ -68,9 +69,10 @@ fn writes_its_files_and_the_same_bytes_for_any_jobs() {
     assert_eq!(rows.len(), 6);
     for (k, r) in rows.iter().enumerate() {
         assert_eq!(r[0], k.to_string());
-        assert_eq!(r[2], "not-converged", "1 s is too short to converge: {r:?}");
-        assert!(r[3].parse::<f64>().unwrap() > 1e-4, "{r:?}");
-        assert_eq!(r[5], "1");
+        // 1 s is too short to converge, or even to tell.
+        assert_eq!(r[2], "undecided", "{r:?}");
+        assert!(r[4].parse::<f64>().unwrap() > 1e-4, "{r:?}");
+        assert_eq!(r[6], "1");
     }
     // Distinct seeds, hence distinct draws.
     let seeds: BTreeSet<&String> = rows.iter().map(|r| &r[1]).collect();
@@ -86,10 +88,10 @@ fn writes_its_files_and_the_same_bytes_for_any_jobs() {
     let m = json(&a.join("mc.json"));
     assert_eq!(m["trials_run"], 6);
     assert_eq!(m["complete"], true);
-    assert_eq!(m["counts"]["not_converged"], 6);
+    assert_eq!(m["counts"]["undecided"], 6);
     assert_eq!(m["failure_rate"], 1.0);
     assert_eq!(m["failed_trials"].as_array().unwrap().len(), 6);
-    let line = format!("{:<14} {:>8}", "not-converged", 6);
+    let line = format!("{:<14} {:>8}", "undecided", 6);
     assert!(out.stdout.contains(&line), "{}", out.stdout);
     // Another seed draws other initial conditions.
     mc(tmp.path(), &s, 6, "other", &["--seed", "1", "--set", SHORT]).assert_code(0);
@@ -152,10 +154,17 @@ fn converging_trials_are_counted_with_their_bound() {
     let dir = tmp.path().join("mc");
     for r in trials(&dir) {
         assert_eq!(r[2], "converged", "{r:?}");
-        let (att, angvel): (f64, f64) = (r[3].parse().unwrap(), r[4].parse().unwrap());
+        // The verdict's rate tends to the linearisation's slowest rate
+        // (attsync margin: -0.8156 /s) from below as faster modes die out
+        // (random initial conditions excite them all).
+        let rate: f64 = r[3].parse().unwrap();
+        assert!((-0.95..-0.80).contains(&rate), "{r:?}");
+        let (att, angvel): (f64, f64) = (r[4].parse().unwrap(), r[5].parse().unwrap());
         assert!(att < 1e-4 && angvel < 1e-4, "{r:?}");
-        let (t3, t6): (f64, f64) = (r[6].parse().unwrap(), r[7].parse().unwrap());
+        let (t3, t6): (f64, f64) = (r[7].parse().unwrap(), r[8].parse().unwrap());
         assert!(0.0 < t3 && t3 <= t6 && t6 <= 40.0, "{r:?}");
+        let (w3, w6): (f64, f64) = (r[9].parse().unwrap(), r[10].parse().unwrap());
+        assert!(0.0 < w3 && w3 <= w6 && w6 <= 40.0, "{r:?}");
     }
     let m = json(&dir.join("mc.json"));
     assert_eq!(m["counts"]["converged"], 3);
@@ -185,12 +194,12 @@ fn a_diverging_trial_is_classified_as_diverged() {
     let out = mc(tmp.path(), &paper("constant-observerless"), 2, "mc", &sets);
     out.assert_code(0);
     for r in trials(&tmp.path().join("mc")) {
-        assert_eq!(r[2], "diverged", "{r:?}");
-        assert!(r[5].parse::<f64>().unwrap() < 40.0, "{r:?}");
-        assert_eq!((r[6].as_str(), r[7].as_str()), ("", ""));
+        assert_eq!(r[2], "diverging", "{r:?}");
+        assert!(r[6].parse::<f64>().unwrap() < 40.0, "{r:?}");
+        assert_eq!((r[7].as_str(), r[8].as_str()), ("", ""));
     }
     let m = json(&tmp.path().join("mc/mc.json"));
-    assert_eq!(m["counts"]["diverged"], 2);
+    assert_eq!(m["counts"]["diverging"], 2);
     let why = m["slowest"][0]["reason"].as_str().unwrap();
     assert!(why.starts_with("diverged at t = "), "{why}");
 }
@@ -291,8 +300,8 @@ fn the_printed_law_stalls_in_every_trial_and_the_corrected_one_converges() {
     assert_eq!(p.len(), 4);
     for (rp, rc) in p.iter().zip(&c) {
         assert_eq!(rp[1], rc[1], "the same seeds: {rp:?} {rc:?}");
-        assert_eq!(rp[2], "not-converged", "{rp:?}");
-        let stall: f64 = rp[3].parse().unwrap();
+        assert_eq!(rp[2], "persistent", "{rp:?}");
+        let stall: f64 = rp[4].parse().unwrap();
         assert!((1e-3..5e-2).contains(&stall), "{rp:?}");
         assert_eq!(rc[2], "converged", "{rc:?}");
     }

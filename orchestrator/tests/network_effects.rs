@@ -197,7 +197,7 @@ fn observerless_paper_converges_with_50ms_delay_not_with_1s() {
         err(small)
     );
     for a in small["agents"].as_array().unwrap() {
-        assert!(a["settle_time_1e-3"].is_number(), "delay 0.05 s: {a:#}");
+        assert!(a["settle_att_1e-3_s"].is_number(), "delay 0.05 s: {a:#}");
     }
     assert!(
         err(large) > 1e-3,
@@ -205,7 +205,7 @@ fn observerless_paper_converges_with_50ms_delay_not_with_1s() {
         err(large)
     );
     for a in large["agents"].as_array().unwrap() {
-        assert!(a["settle_time_1e-3"].is_null(), "delay 1 s: {a:#}");
+        assert!(a["settle_att_1e-3_s"].is_null(), "delay 1 s: {a:#}");
     }
 }
 
@@ -390,10 +390,34 @@ fn margin_line(stdout: &str) -> (String, String) {
     (lo.to_string(), hi.to_string())
 }
 
+/// The margin of `sweep.json`: (converges_up_to, fails_from, linear margin).
+fn margin_json(dir: &Path) -> (f64, f64, f64, serde_json::Value) {
+    let info: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(dir.join("sweep.json")).unwrap()).unwrap();
+    let m = &info["margin"];
+    let lo = m["converges_up_to"].as_f64().expect("converges_up_to");
+    let hi = m["fails_from"].as_f64().expect("fails_from");
+    assert_eq!(m["linear"]["kind"], "crossing", "{info:#}");
+    let linear = m["linear"]["delay"].as_f64().expect("a linear margin");
+    (lo, hi, linear, info)
+}
+
+/// Whether a row's error decays (the bisection's criterion).
+fn decays(header: &[String], r: &[String]) -> bool {
+    match field(header, r, "verdict") {
+        "converged" | "converging" => true,
+        "persistent" | "diverging" => false,
+        "undecided" => field(header, r, "decay_rate_per_s").parse::<f64>().unwrap() < 0.0,
+        v => panic!("verdict {v:?}"),
+    }
+}
+
+/// The stability boundary of the paper's observerless experiment: the
+/// bisection, on each run's verdict with runs extended until it is final,
+/// brackets the linearisation's exact margin (0.3892 s, `attsync margin`);
+/// every row agrees with its run's summary.json and scenario.toml.
 #[test]
 fn sweep_network_delay_with_margin() {
-    // Over 15 s the observerless experiment converges with no delay and with
-    // 50 ms (final max att_err 7e-6 and 4e-4), not with 1 s (0.68).
     let tmp = tempfile::tempdir().unwrap();
     let cwd = tmp.path();
     let out = sweep(
@@ -401,7 +425,8 @@ fn sweep_network_delay_with_margin() {
         "network.delay",
         "0,0.05,1.0",
         "sw",
-        &["--find-margin", "--bisect", "4"],
+        // Near the margin the rates are ~0.003/s: long runs resolve them.
+        &["--find-margin", "--bisect", "6", "--max-duration", "1280"],
     );
     out.assert_ok();
     let dir = cwd.join("sw");
@@ -416,54 +441,70 @@ fn sweep_network_delay_with_margin() {
     let (header, rows) = read_sweep(&dir);
     assert_eq!(
         header[..4],
-        ["value", "final_max_att_err", "time_to_1e-3", "converged"].map(String::from),
+        ["value", "verdict", "decay_rate_per_s", "linear_rate_per_s"].map(String::from),
         "{header:?}"
     );
-    // One row per listed value, in order, then the 4 bisection points.
-    assert_eq!(rows.len(), 3 + 4, "{rows:?}");
+    // One row per listed value, in order, then the 6 bisection points.
+    assert_eq!(rows.len(), 3 + 6, "{rows:?}");
     let values: Vec<&str> = rows.iter().map(|r| field(&header, r, "value")).collect();
     assert_eq!(values[..3], ["0", "0.05", "1.0"]);
-    let converged = |r: &[String]| match field(&header, r, "converged") {
-        "true" => true,
-        "false" => false,
-        x => panic!("converged = {x:?}"),
-    };
-    assert!(converged(&rows[0]), "delay 0: {:?}", rows[0]);
-    assert!(converged(&rows[1]), "delay 0.05: {:?}", rows[1]);
-    assert!(!converged(&rows[2]), "delay 1.0: {:?}", rows[2]);
+    assert_eq!(
+        field(&header, &rows[0], "verdict"),
+        "converged",
+        "{:?}",
+        rows[0]
+    );
+    assert_eq!(
+        field(&header, &rows[1], "verdict"),
+        "converged",
+        "{:?}",
+        rows[1]
+    );
+    assert!(!decays(&header, &rows[2]), "delay 1.0: {:?}", rows[2]);
 
-    // Every row agrees with its run's summary.json.
+    // Every row agrees with its run's summary.json and scenario.toml.
     for r in &rows {
         assert_eq!(field(&header, r, "complete"), "true", "{r:?}");
         let run_dir = dir.join(field(&header, r, "run"));
         let s = summary(&run_dir);
         let err: f64 = field(&header, r, "final_max_att_err").parse().unwrap();
         assert_eq!(Some(err), s["max_final_att_err"].as_f64(), "{r:?}");
-        assert_eq!(converged(r), err < 1e-3, "{r:?}");
+        assert_eq!(field(&header, r, "verdict"), s["verdict"]["kind"], "{r:?}");
+        let rate = field(&header, r, "decay_rate_per_s").parse::<f64>().ok();
+        assert_eq!(rate, s["verdict"]["decay_rate"].as_f64(), "{r:?}");
+        assert_eq!(
+            field(&header, r, "converged") == "true",
+            s["verdict"]["kind"] == "converged"
+        );
         let settle: Vec<Option<f64>> = s["agents"]
             .as_array()
             .unwrap()
             .iter()
-            .map(|a| a["settle_time_1e-3"].as_f64())
+            .map(|a| a["settle_att_1e-3_s"].as_f64())
             .collect();
         let latest = settle.iter().try_fold(0.0_f64, |m, t| t.map(|t| m.max(t)));
-        let t = field(&header, r, "time_to_1e-3");
+        let t = field(&header, r, "settle_att_1e-3_s");
         match latest {
             Some(x) => assert_eq!(t.parse::<f64>().ok(), Some(x), "{r:?}"),
             None => assert_eq!(t, "", "{r:?}: an agent never settles"),
         }
-        // The run really had that delay.
+        // The run really had that delay, and ran to the horizon it says
+        // (extended from 15 s until its verdict was final).
         let eff: toml::Table = fs::read_to_string(run_dir.join("scenario.toml"))
             .unwrap()
             .parse()
             .unwrap();
         let v: f64 = field(&header, r, "value").parse().unwrap();
         assert_eq!(num(&eff["network"]["delay"]), Some(v), "{r:?}");
-        assert_eq!(num(&eff["simulation"]["duration"]), Some(15.0), "{r:?}");
+        let duration: f64 = field(&header, r, "duration_s").parse().unwrap();
+        assert_eq!(num(&eff["simulation"]["duration"]), Some(duration), "{r:?}");
+        assert_eq!(s["duration"].as_f64(), Some(duration), "{r:?}");
+        assert!(duration >= 15.0, "{r:?}");
+        assert_eq!(s["until"]["rule"], "settled", "{r:?}");
     }
 
-    // The margin: bracketed by the given values, lo converges, hi does not,
-    // both in the rows.
+    // The margin: lo decays, hi does not, both in the rows; the
+    // linearisation's margin lies in the bracket (widened by one step).
     let (lo, hi) = margin_line(&out.stdout);
     let (l, h): (f64, f64) = (lo.parse().unwrap(), hi.parse().unwrap());
     assert!(0.05 <= l && l < h && h <= 1.0, "margin {lo} .. {hi}");
@@ -472,13 +513,22 @@ fn sweep_network_delay_with_margin() {
             .find(|r| field(&header, r, "value") == v)
             .unwrap_or_else(|| panic!("no row for {v}: {rows:?}"))
     };
-    assert!(converged(row(&lo)), "{lo} is said to converge");
-    assert!(!converged(row(&hi)), "{hi} is said not to");
-    let info: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(dir.join("sweep.json")).unwrap()).unwrap();
+    assert!(decays(&header, row(&lo)), "{lo} is said to decay");
+    assert!(!decays(&header, row(&hi)), "{hi} is said not to");
+    let (jl, jh, linear, info) = margin_json(&dir);
     assert_eq!(info["param"], "network.delay");
-    assert_eq!(info["margin"]["largest_converging"].as_f64(), Some(l));
-    assert_eq!(info["margin"]["smallest_failing"].as_f64(), Some(h));
+    assert_eq!((jl, jh), (l, h));
+    assert!((linear - 0.3892).abs() < 1e-3, "linear margin {linear}");
+    assert!(
+        l - 0.001 <= linear && linear <= h + 0.001,
+        "{linear} outside [{l}, {h}]"
+    );
+    assert!(info["margin"]["warning"].is_null(), "{info:#}");
+    assert!(
+        out.stdout.contains("linear margin: 0.389"),
+        "{}",
+        out.stdout
+    );
     // Bisection points are rounded to the step (the default quantum for a delay).
     for r in &rows[3..] {
         let v: f64 = field(&header, r, "value").parse().unwrap();
@@ -486,10 +536,44 @@ fn sweep_network_delay_with_margin() {
     }
 }
 
-/// The bisection point between 0 and 0.142 is 71 steps; it must be reported
-/// as `0.071` (as given on a command line), not as `71 × 0.001` with binary
-/// noise (`0.07100000000000001`), in `sweep.csv`, the run directory's name,
-/// the margin line and `sweep.json`.
+/// The bracket `--find-margin` finds does not depend on the horizon the
+/// runs start from (15 s or 40 s): the runs are extended until their
+/// verdicts are final.
+#[test]
+fn the_sweep_margin_does_not_depend_on_the_starting_duration() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cwd = tmp.path();
+    let margin = |out: &str, duration: &str| {
+        let set = format!("simulation.duration={duration}");
+        sweep(
+            cwd,
+            "network.delay",
+            "0.3,0.5",
+            out,
+            &[
+                "--find-margin",
+                "--bisect",
+                "4",
+                "--set",
+                &set,
+                "--max-duration",
+                "1280",
+            ],
+        )
+        .assert_ok();
+        let (lo, hi, _, _) = margin_json(&cwd.join(out));
+        (lo, hi)
+    };
+    let short = margin("short", "15");
+    let long = margin("long", "40");
+    assert_eq!(short, long, "the bracket moved with the starting duration");
+    assert!(short.0 < 0.3892 && 0.3892 < short.1 + 0.001, "{short:?}");
+}
+
+/// The bisection point between 0 and 0.742 is 371 steps; it must be
+/// reported as `0.371` (as given on a command line), not as `371 × 0.001`
+/// with binary noise, in `sweep.csv`, the run directory's name, the margin
+/// line and `sweep.json`.
 #[test]
 fn sweep_bisection_points_are_printed_without_binary_noise() {
     let tmp = tempfile::tempdir().unwrap();
@@ -497,7 +581,7 @@ fn sweep_bisection_points_are_printed_without_binary_noise() {
     let out = sweep(
         cwd,
         "network.delay",
-        "0,0.142",
+        "0,0.742",
         "sw",
         &["--find-margin", "--bisect", "1"],
     );
@@ -505,15 +589,19 @@ fn sweep_bisection_points_are_printed_without_binary_noise() {
     let dir = cwd.join("sw");
     let (header, rows) = read_sweep(&dir);
     assert_eq!(rows.len(), 3, "{rows:?}");
-    assert_eq!(field(&header, &rows[1], "converged"), "false", "{rows:?}");
-    assert_eq!(field(&header, &rows[0], "converged"), "true", "{rows:?}");
+    assert!(decays(&header, &rows[0]), "{rows:?}");
+    assert!(!decays(&header, &rows[1]), "{rows:?}");
     let point = &rows[2];
     let v: f64 = field(&header, point, "value").parse().unwrap();
-    assert!((v - 0.071).abs() < 1e-12, "{point:?}");
-    assert_eq!(field(&header, point, "value"), "0.071", "{point:?}");
-    assert_eq!(field(&header, point, "run"), "runs/002-0.071", "{point:?}");
-    let (_, hi) = margin_line(&out.stdout);
-    assert_eq!(hi, "0.071", "{}", out.stdout);
+    assert!((v - 0.371).abs() < 1e-12, "{point:?}");
+    assert_eq!(field(&header, point, "value"), "0.371", "{point:?}");
+    assert_eq!(field(&header, point, "run"), "runs/002-0.371", "{point:?}");
+    // 0.371 s is below the margin (0.389 s): its error decays.
+    assert!(decays(&header, point), "{point:?}");
+    let (lo, _) = margin_line(&out.stdout);
+    assert_eq!(lo, "0.371", "{}", out.stdout);
+    let (l, _, _, _) = margin_json(&dir);
+    assert_eq!(l.to_string(), "0.371");
 }
 
 #[test]
@@ -553,7 +641,7 @@ fn sweep_failures_name_the_field_and_leave_nothing() {
     );
     assert!(entries(cwd).is_empty(), "{:?}", entries(cwd));
 
-    // --find-margin without a bracket (neither value converges in 1 s).
+    // --find-margin without a bracket (the first value's error does not decay).
     let out = sweep(
         cwd,
         "network.delay",

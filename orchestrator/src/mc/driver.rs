@@ -137,10 +137,16 @@ fn head(base: &Base, o: &McOptions) -> McSummary {
         trials_run: 0,
         complete: false,
         duration: net.steps as f64 * net.dt,
-        tolerance: o.tolerance,
+        tolerance: o.judging.tolerance,
+        until: match o.judging.until {
+            crate::until::Until::Horizon => None,
+            crate::until::Until::Settled { max_duration } => Some(max_duration),
+        },
         criterion: format!(
-            "converged: complete, and every agent's final |R_i R_0^T|_I and ||w_i - w_0|| (rad/s) below {:e}",
-            o.tolerance
+            "the verdict on the largest |R_i R_0^T|_I over agents over the whole run \
+             (docs/verdicts.md): converged = below {:e} and staying there; a failure = \
+             neither converged nor converging",
+            o.judging.tolerance
         ),
         dispersion: base.dispersion.clone(),
         counts: report::Counts::default(),
@@ -164,10 +170,10 @@ fn one(
 ) -> Result<Ran, McError> {
     let p = base.prepare(k)?;
     match o.engine {
-        Engine::InProcess => Ok(run_in_process(&p, o.tolerance, interrupt)),
+        Engine::InProcess => Ok(run_in_process(&p, &o.judging, interrupt)),
         Engine::Processes => {
             let logs = layout::McLayout::new(dir).trial_logs(k);
-            let ran = run_processes(&p, &o.processes, &logs, o.tolerance, interrupt)
+            let ran = run_processes(&p, &o.processes, &logs, &o.judging, interrupt)
                 .map_err(|source| McError::Processes { trial: k, source })?;
             let failed = matches!(&ran, Ran::Done(r) if r.outcome == super::Outcome::Failed);
             if !failed {
@@ -302,6 +308,7 @@ pub fn trial_alone(
         threads: 1,
         view: true,
         hosts: None,
+        judging: o.judging,
     };
     let summary = crate::run::run(&prepared.loaded, &opts, interrupt)?;
     if let Some(signal) = interrupt.signal() {
@@ -309,11 +316,11 @@ pub fn trial_alone(
     }
     let trace = trace_of_run(out, &base)?;
     let end = match (&summary.diverged, &summary.incomplete_reason) {
-        (Some(_), Some(why)) => End::Diverged(why.clone()),
+        (Some(d), Some(why)) => End::Diverged(d.t, why.clone()),
         (_, Some(why)) => End::Failed(why.clone()),
         _ => End::Complete,
     };
-    let result = classify(k, prepared.seed, end, &trace, o.tolerance);
+    let result = classify(k, prepared.seed, end, &trace, &o.judging);
     let command = run_command(o, &prepared);
     Ok(Alone {
         prepared,

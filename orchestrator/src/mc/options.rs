@@ -5,8 +5,9 @@ use crate::processes::ProcessOptions;
 use crate::run::Engine;
 use std::path::PathBuf;
 
-/// Default `--tolerance`: final `|Rᵢ R₀ᵀ|_I` and `‖ωᵢ − ω₀‖` (rad/s) below
-/// it (chosen by measurement on the paper's scenarios, README "Monte Carlo").
+/// Default `--tolerance`: the largest `|Rᵢ R₀ᵀ|_I` over agents below it and
+/// staying there (chosen by measurement on the paper's scenarios, README
+/// "Monte Carlo").
 pub const DEFAULT_TOLERANCE: f64 = 1e-4;
 
 /// A Monte Carlo's options.
@@ -26,8 +27,8 @@ pub struct McOptions {
     pub engine: Engine,
     /// Process-engine options.
     pub processes: ProcessOptions,
-    /// Convergence tolerance (> 0).
-    pub tolerance: f64,
+    /// The tolerance of `converged` and how long each trial goes.
+    pub judging: crate::run::Judging,
     /// Results directory.
     pub out: PathBuf,
     /// Draw a progress bar on stderr.
@@ -37,14 +38,15 @@ pub struct McOptions {
 }
 
 impl McOptions {
-    /// Checks `--trials`, `--jobs`, `--tolerance` and the process engine's timeouts.
+    /// Checks `--trials`, `--jobs`, `--tolerance`, `--max-duration` and the
+    /// process engine's timeouts.
     ///
     /// # Errors
     /// The first option out of its range.
     pub fn validate(&self) -> Result<(), OptionError> {
         options::count("--trials", self.trials, 1, u64::MAX)?;
         options::count("--jobs", self.jobs as u64, 1, u64::MAX)?;
-        options::positive("--tolerance", self.tolerance)?;
+        self.judging.validate()?;
         options::seconds("--stage-timeout", self.processes.stage_timeout)?;
         options::seconds("--start-timeout", self.processes.start_timeout)
     }

@@ -1,24 +1,29 @@
 //! A trial's outcome: what is recorded of its run ([`Trace`]: the largest
-//! error over agents at each sample, not whole trajectories) and its
-//! classification ([`classify`]).
+//! errors over agents at each sample, not whole trajectories) and its
+//! classification ([`classify`]) by the verdict (`docs/verdicts.md`), the
+//! same as `attsync run`'s.
 
-use crate::results::summary::settle_time;
+use crate::results::summary::Settle;
+use crate::run::Judging;
 use attitude::engine::Snapshot;
 use attitude::metrics::errors;
+use attsync_verdict::Kind;
 use serde::Serialize;
 
-/// How a trial ended.
+/// How a trial ended: its verdict, or that a node process failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Outcome {
-    /// Complete, and every agent's final attitude error `|Rᵢ R₀ᵀ|_I` and
-    /// angular-velocity error `‖ωᵢ − ω₀‖` below the tolerance.
+    /// The largest attitude error over agents is below the tolerance and stays there.
     Converged,
-    /// Complete, but some final error at or above the tolerance (how far:
-    /// the final errors).
-    NotConverged,
-    /// A state left the envelope (`[guard]`, `attitude::guard`).
-    Diverged,
+    /// It decays, but is not below the tolerance by the end (not a failure).
+    Converging,
+    /// Bounded and not decaying above the tolerance (an offset or an oscillation).
+    Persistent,
+    /// Growing, or a state left the envelope (`[guard]`, `attitude::guard`).
+    Diverging,
+    /// Too short to tell.
+    Undecided,
     /// A node process failed (process engine).
     Failed,
 }
@@ -29,17 +34,40 @@ impl Outcome {
     pub fn name(self) -> &'static str {
         match self {
             Outcome::Converged => "converged",
-            Outcome::NotConverged => "not-converged",
-            Outcome::Diverged => "diverged",
+            Outcome::Converging => "converging",
+            Outcome::Persistent => "persistent",
+            Outcome::Diverging => "diverging",
+            Outcome::Undecided => "undecided",
             Outcome::Failed => "failed",
         }
     }
 
+    /// The outcome of a verdict of kind `kind`.
+    #[must_use]
+    pub fn of(kind: Kind) -> Self {
+        match kind {
+            Kind::Converged => Outcome::Converged,
+            Kind::Converging => Outcome::Converging,
+            Kind::Persistent => Outcome::Persistent,
+            Kind::Diverging => Outcome::Diverging,
+            Kind::Undecided => Outcome::Undecided,
+        }
+    }
+
+    /// Whether this outcome counts as a failure: anything but converged or
+    /// converging (whose error decays).
+    #[must_use]
+    pub fn is_failure(self) -> bool {
+        !matches!(self, Outcome::Converged | Outcome::Converging)
+    }
+
     /// Every outcome, in the order of the summary table.
-    pub const ALL: [Outcome; 4] = [
+    pub const ALL: [Outcome; 6] = [
         Outcome::Converged,
-        Outcome::NotConverged,
-        Outcome::Diverged,
+        Outcome::Converging,
+        Outcome::Persistent,
+        Outcome::Diverging,
+        Outcome::Undecided,
         Outcome::Failed,
     ];
 }
@@ -49,8 +77,8 @@ impl Outcome {
 pub enum End {
     /// It reached the horizon.
     Complete,
-    /// A state left the envelope (the run's message).
-    Diverged(String),
+    /// A state left the envelope at `t` s (the run's message).
+    Diverged(f64, String),
     /// A node failed (the run's reason).
     Failed(String),
 }
@@ -60,13 +88,10 @@ pub enum End {
 pub struct Trace {
     /// Sample times, s (as `errors.csv` writes them).
     pub t: Vec<f64>,
-    /// `max over agents of max(|Rᵢ R₀ᵀ|_I, ‖ωᵢ − ω₀‖)` at each sample (NaN
-    /// if any is NaN).
-    pub max_err: Vec<f64>,
-    /// The largest attitude error over agents at the last sample.
-    pub final_att: f64,
-    /// The largest angular-velocity error over agents at the last sample.
-    pub final_angvel: f64,
+    /// The largest `|Rᵢ R₀ᵀ|_I` over agents at each sample (NaN if any is NaN).
+    pub att: Vec<f64>,
+    /// The largest `‖ωᵢ − ω₀‖` over agents at each sample, rad/s.
+    pub angvel: Vec<f64>,
     dt: f64,
     has_observer: bool,
 }
@@ -85,8 +110,6 @@ impl Trace {
     #[must_use]
     pub fn new(dt: f64, has_observer: bool) -> Self {
         Self {
-            final_att: f64::NAN,
-            final_angvel: f64::NAN,
             dt,
             has_observer,
             ..Self::default()
@@ -113,8 +136,26 @@ impl Trace {
     /// `att` and `angvel`.
     pub fn push(&mut self, t: f64, att: f64, angvel: f64) {
         self.t.push(t);
-        self.max_err.push(nan_max(att, angvel));
-        (self.final_att, self.final_angvel) = (att, angvel);
+        self.att.push(att);
+        self.angvel.push(angvel);
+    }
+
+    /// Forgets every sample (a run started again with a longer horizon).
+    pub fn clear(&mut self) {
+        self.t.clear();
+        self.att.clear();
+        self.angvel.clear();
+    }
+
+    /// The verdict on the attitude errors recorded so far.
+    #[must_use]
+    pub fn verdict(&self, judging: &Judging) -> attsync_verdict::Verdict {
+        attsync_verdict::classify(
+            &self.t,
+            &self.att,
+            judging.tolerance,
+            &attsync_verdict::Thresholds::default(),
+        )
     }
 }
 
@@ -127,54 +168,55 @@ pub struct TrialResult {
     pub seed: u64,
     /// How it ended.
     pub outcome: Outcome,
+    /// The verdict's decay rate, 1/s (negative = decaying).
+    pub decay_rate: Option<f64>,
     /// Largest final attitude error over agents (at the last sample).
     pub final_max_att_err: f64,
     /// Largest final angular-velocity error over agents, rad/s.
     pub final_max_angvel_err: f64,
     /// Time of the last sample, s.
     pub t_end: f64,
-    /// First sample time after which every agent's attitude and
-    /// angular-velocity errors stay below 1e-3 to the end (`None`: never).
-    pub settle_1e3: Option<f64>,
-    /// The same for 1e-6.
-    pub settle_1e6: Option<f64>,
+    /// When the largest errors over agents settled ([`Settle`]).
+    #[serde(flatten)]
+    pub settle: Settle,
     /// Why a diverged or failed trial stopped.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
 }
 
-/// Classifies a trial that ended as `end` with `trace` recorded, against
-/// `tolerance` (> 0). Settle times only count for a complete run.
+/// Classifies a trial that ended as `end` with `trace` recorded, by its
+/// verdict with `judging`'s tolerance. Settle times only count for a
+/// complete run.
 #[must_use]
-pub fn classify(trial: u64, seed: u64, end: End, trace: &Trace, tolerance: f64) -> TrialResult {
+pub fn classify(trial: u64, seed: u64, end: End, trace: &Trace, judging: &Judging) -> TrialResult {
     let complete = end == End::Complete;
-    let settle = |eps| {
-        complete
-            .then(|| settle_time(&trace.t, &trace.max_err, eps))
-            .flatten()
-    };
-    let (outcome, reason) = match end {
+    let (verdict, outcome, reason) = match end {
         End::Complete => {
-            let below = trace.final_att < tolerance && trace.final_angvel < tolerance;
-            let o = if below {
-                Outcome::Converged
-            } else {
-                Outcome::NotConverged
-            };
-            (o, None)
+            let v = trace.verdict(judging);
+            let o = Outcome::of(v.kind);
+            (Some(v), o, None)
         }
-        End::Diverged(why) => (Outcome::Diverged, Some(why)),
-        End::Failed(why) => (Outcome::Failed, Some(why)),
+        End::Diverged(t, why) => (
+            Some(attsync_verdict::diverged(t, judging.tolerance)),
+            Outcome::Diverging,
+            Some(why),
+        ),
+        End::Failed(why) => (None, Outcome::Failed, Some(why)),
+    };
+    let settle = if complete {
+        Settle::of(&trace.t, &trace.att, &trace.angvel)
+    } else {
+        Settle::default()
     };
     TrialResult {
         trial,
         seed,
         outcome,
-        final_max_att_err: trace.final_att,
-        final_max_angvel_err: trace.final_angvel,
+        decay_rate: verdict.and_then(|v| v.decay_rate),
+        final_max_att_err: trace.att.last().copied().unwrap_or(f64::NAN),
+        final_max_angvel_err: trace.angvel.last().copied().unwrap_or(f64::NAN),
         t_end: trace.t.last().copied().unwrap_or(0.0),
-        settle_1e3: settle(1e-3),
-        settle_1e6: settle(1e-6),
+        settle,
         reason,
     }
 }
@@ -183,57 +225,81 @@ pub fn classify(trial: u64, seed: u64, end: End, trace: &Trace, tolerance: f64) 
 mod tests {
     use super::*;
 
-    fn trace(errs: &[f64], att: f64, angvel: f64) -> Trace {
+    fn trace(att: &[f64], angvel: &[f64], dt: f64) -> Trace {
         Trace {
-            t: (0..errs.len()).map(|k| k as f64).collect(),
-            max_err: errs.to_vec(),
-            final_att: att,
-            final_angvel: angvel,
-            dt: 1.0,
+            t: (0..att.len()).map(|k| k as f64 * dt).collect(),
+            att: att.to_vec(),
+            angvel: angvel.to_vec(),
+            dt,
             has_observer: false,
         }
     }
 
+    fn judging() -> Judging {
+        Judging {
+            tolerance: 1e-4,
+            ..Judging::default()
+        }
+    }
+
+    /// `n` samples of `a e^{λ t}` at 0.1 s.
+    fn decay(a: f64, lambda: f64, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|k| a * (lambda * k as f64 * 0.1).exp())
+            .collect()
+    }
+
     #[test]
-    fn a_converging_a_stalling_and_a_diverging_trial() {
-        let good = trace(&[1.0, 1e-2, 1e-4, 1e-7], 1e-7, 1e-8);
-        let r = classify(0, 9, End::Complete, &good, 1e-4);
+    fn a_converged_a_converging_a_persistent_and_a_diverged_trial() {
+        let fast = decay(1.0, -1.0, 400);
+        let r = classify(0, 9, End::Complete, &trace(&fast, &fast, 0.1), &judging());
         assert_eq!(r.outcome, Outcome::Converged);
-        assert_eq!((r.settle_1e3, r.settle_1e6), (Some(2.0), Some(3.0)));
-        assert_eq!(r.t_end, 3.0);
-        // Stalled at an error of 0.5: not converged, and how far.
-        let stall = trace(&[1.0, 0.5, 0.5, 0.5], 0.5, 1e-9);
-        let r = classify(1, 9, End::Complete, &stall, 1e-4);
-        assert_eq!(r.outcome, Outcome::NotConverged);
-        assert_eq!((r.final_max_att_err, r.settle_1e3), (0.5, None));
-        // The angular velocity counts too.
-        let spin = trace(&[1.0, 1e-5, 1e-5, 1e-5], 1e-9, 1e-3);
+        assert!(!r.outcome.is_failure());
         assert_eq!(
-            classify(2, 9, End::Complete, &spin, 1e-4).outcome,
-            Outcome::NotConverged
+            r.settle.att_1e3,
+            attsync_verdict::settle_time(&trace(&fast, &fast, 0.1).t, &fast, 1e-3)
         );
-        let boom = trace(&[1.0, 1e-7], 1e-7, 1e-7);
+        assert_eq!(r.t_end, 399.0 * 0.1);
+        // Decaying at 0.05/s from 1: at 1.4e-1 after 40 s: converging, no failure.
+        let slow = decay(1.0, -0.05, 400);
+        let r = classify(1, 9, End::Complete, &trace(&slow, &slow, 0.1), &judging());
+        assert_eq!(r.outcome, Outcome::Converging, "{r:?}");
+        assert!(!r.outcome.is_failure());
+        assert!((r.decay_rate.unwrap() + 0.05).abs() < 0.0025, "{r:?}");
+        // Stalled at an error of 0.5: persistent, and how far.
+        let stall = vec![0.5; 400];
+        let r = classify(2, 9, End::Complete, &trace(&stall, &stall, 0.1), &judging());
+        assert_eq!(r.outcome, Outcome::Persistent);
+        assert!(r.outcome.is_failure());
+        assert_eq!((r.final_max_att_err, r.settle.att_1e3), (0.5, None));
         let r = classify(
             3,
             9,
-            End::Diverged("diverged at t = 2 s".into()),
-            &boom,
-            1e-4,
+            End::Diverged(2.0, "diverged at t = 2 s".into()),
+            &trace(&fast[..20], &fast[..20], 0.1),
+            &judging(),
         );
-        assert_eq!(r.outcome, Outcome::Diverged);
+        assert_eq!(r.outcome, Outcome::Diverging);
         assert_eq!(
-            (r.settle_1e3, r.reason.as_deref()),
+            (r.settle.att_1e3, r.reason.as_deref()),
             (None, Some("diverged at t = 2 s"))
         );
-        let dead = classify(4, 9, End::Failed("agent-2 died".into()), &boom, 1e-4);
+        let dead = classify(
+            4,
+            9,
+            End::Failed("agent-2 died".into()),
+            &trace(&fast, &fast, 0.1),
+            &judging(),
+        );
         assert_eq!(dead.outcome, Outcome::Failed);
     }
 
     #[test]
     fn a_nan_error_is_never_below_the_tolerance() {
-        let nan = trace(&[1.0, f64::NAN], f64::NAN, 0.0);
-        let r = classify(0, 0, End::Complete, &nan, 1e-4);
-        assert_eq!((r.outcome, r.settle_1e3), (Outcome::NotConverged, None));
+        let mut att = decay(1.0, -1.0, 400);
+        att[399] = f64::NAN;
+        let r = classify(0, 0, End::Complete, &trace(&att, &att, 0.1), &judging());
+        assert_eq!((r.outcome, r.settle.att_1e3), (Outcome::Diverging, None));
         assert!(nan_max(1.0, f64::NAN).is_nan() && nan_max(f64::NAN, 1.0).is_nan());
     }
 }

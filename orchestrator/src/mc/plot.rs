@@ -50,8 +50,8 @@ fn ecdf<DB: DrawingBackend>(
         .draw()
         .map_err(|e| e.to_string())?;
     let curves: [(&str, Pick, RGBColor); 2] = [
-        ("to 1e-3", |r| r.settle_1e3, BLUE),
-        ("to 1e-6", |r| r.settle_1e6, RED),
+        ("att < 1e-3", |r| r.settle.att_1e3, BLUE),
+        ("att < 1e-6", |r| r.settle.att_1e6, RED),
     ];
     for (label, pick, color) in curves {
         let mut times: Vec<f64> = results.iter().filter_map(pick).collect();

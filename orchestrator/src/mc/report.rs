@@ -12,8 +12,8 @@ use serde::Serialize;
 use std::fmt::Write as _;
 
 /// The exact header of `trials.csv`.
-pub const TRIALS_HEADER: &str =
-    "trial,seed,outcome,final_max_att_err,final_max_angvel_err,t_end,settle_1e-3,settle_1e-6";
+pub const TRIALS_HEADER: &str = "trial,seed,outcome,decay_rate_per_s,final_max_att_err,\
+final_max_angvel_err_rad_s,t_end_s,settle_att_1e-3_s,settle_att_1e-6_s,settle_angvel_1e-3_s,settle_angvel_1e-6_s";
 
 /// The exact header of `initial.csv`.
 pub const INITIAL_HEADER: &str = "trial,agent,q_w,q_x,q_y,q_z,omega_x,omega_y,omega_z,qhat_w,qhat_x,qhat_y,qhat_z,omegahat_x,omegahat_y,omegahat_z,sigmahat_x,sigmahat_y,sigmahat_z";
@@ -32,15 +32,18 @@ fn opt(x: Option<f64>) -> String {
 #[must_use]
 pub fn trial_row(r: &TrialResult) -> String {
     format!(
-        "{},{},{},{},{},{},{},{}",
+        "{},{},{},{},{},{},{},{},{},{},{}",
         r.trial,
         r.seed,
         r.outcome.name(),
+        opt(r.decay_rate),
         r.final_max_att_err,
         r.final_max_angvel_err,
         r.t_end,
-        opt(r.settle_1e3),
-        opt(r.settle_1e6)
+        opt(r.settle.att_1e3),
+        opt(r.settle.att_1e6),
+        opt(r.settle.angvel_1e3),
+        opt(r.settle.angvel_1e6)
     )
 }
 
@@ -96,10 +99,14 @@ pub fn initial_rows(s: &mut String, trial: u64, ids: &[u32], d: &Dispersion, dra
 pub struct Counts {
     /// Converged.
     pub converged: u64,
-    /// Not converged.
-    pub not_converged: u64,
-    /// Diverged.
-    pub diverged: u64,
+    /// Converging (decaying, not below the tolerance by the end).
+    pub converging: u64,
+    /// Persistent.
+    pub persistent: u64,
+    /// Diverging (growing, or a state left the envelope).
+    pub diverging: u64,
+    /// Undecided.
+    pub undecided: u64,
     /// Failed (a process).
     pub failed: u64,
 }
@@ -118,8 +125,10 @@ impl Counts {
     fn get_mut(&mut self, o: Outcome) -> &mut u64 {
         match o {
             Outcome::Converged => &mut self.converged,
-            Outcome::NotConverged => &mut self.not_converged,
-            Outcome::Diverged => &mut self.diverged,
+            Outcome::Converging => &mut self.converging,
+            Outcome::Persistent => &mut self.persistent,
+            Outcome::Diverging => &mut self.diverging,
+            Outcome::Undecided => &mut self.undecided,
             Outcome::Failed => &mut self.failed,
         }
     }
@@ -129,8 +138,10 @@ impl Counts {
     pub fn get(&self, o: Outcome) -> u64 {
         match o {
             Outcome::Converged => self.converged,
-            Outcome::NotConverged => self.not_converged,
-            Outcome::Diverged => self.diverged,
+            Outcome::Converging => self.converging,
+            Outcome::Persistent => self.persistent,
+            Outcome::Diverging => self.diverging,
+            Outcome::Undecided => self.undecided,
             Outcome::Failed => self.failed,
         }
     }
@@ -153,17 +164,21 @@ pub struct McSummary {
     pub trials_run: u64,
     /// Whether every trial asked for ran.
     pub complete: bool,
-    /// Simulated horizon of each trial, s.
+    /// Simulated horizon of each trial, s (the scenario's; `--until
+    /// settled` may extend a trial's: its `t_end`).
     pub duration: f64,
-    /// The convergence tolerance on the final attitude and angular-velocity errors.
+    /// The tolerance of `converged` on the largest attitude error over agents.
     pub tolerance: f64,
+    /// `--until settled`: the longest horizon of a trial, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub until: Option<f64>,
     /// The criterion, in words.
     pub criterion: String,
     /// What was dispersed.
     pub dispersion: Dispersion,
     /// Trials of each outcome.
     pub counts: Counts,
-    /// Trials that did not converge (not converged, diverged or failed).
+    /// Trials that are neither converged nor converging.
     pub failures: u64,
     /// `failures / trials_run`.
     pub failure_rate: f64,
@@ -171,7 +186,7 @@ pub struct McSummary {
     pub failure_rate_upper_95: f64,
     /// The exact two-sided 95 % Clopper–Pearson interval of the failure rate.
     pub failure_rate_interval_95: [f64; 2],
-    /// Indices of the trials that did not converge.
+    /// Indices of the trials that failed (neither converged nor converging).
     pub failed_trials: Vec<u64>,
     /// The slowest trials (latest settle time to 1e-6; never settled first).
     pub slowest: Vec<TrialResult>,
@@ -182,7 +197,7 @@ pub struct McSummary {
 pub fn summarise(head: McSummary, results: &[TrialResult]) -> McSummary {
     let counts = Counts::of(results);
     let n = results.len() as u64;
-    let failures = n - counts.converged;
+    let failures = results.iter().filter(|r| r.outcome.is_failure()).count() as u64;
     let alpha = 1.0 - CONFIDENCE;
     let (upper, interval) = if n == 0 {
         (1.0, [0.0, 1.0])
@@ -191,7 +206,7 @@ pub fn summarise(head: McSummary, results: &[TrialResult]) -> McSummary {
         (stats::upper_bound(failures, n, alpha), [lo, hi])
     };
     let mut slowest: Vec<TrialResult> = results.to_vec();
-    let key = |r: &TrialResult| r.settle_1e6.unwrap_or(f64::INFINITY);
+    let key = |r: &TrialResult| r.settle.att_1e6.unwrap_or(f64::INFINITY);
     slowest.sort_by(|a, b| key(b).total_cmp(&key(a)).then(a.trial.cmp(&b.trial)));
     slowest.truncate(SLOWEST);
     McSummary {
@@ -205,7 +220,7 @@ pub fn summarise(head: McSummary, results: &[TrialResult]) -> McSummary {
         failure_rate_upper_95: upper,
         failure_rate_interval_95: interval,
         failed_trials: (results.iter())
-            .filter(|r| r.outcome != Outcome::Converged)
+            .filter(|r| r.outcome.is_failure())
             .map(|r| r.trial)
             .collect(),
         slowest,
@@ -243,8 +258,17 @@ pub fn table(s: &McSummary, results: &[TrialResult]) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
-        "{}: {} of {} trials ({} engine), seed {}, {} s each, tolerance {:e}",
-        s.scenario, s.trials_run, s.trials, s.engine, s.seed, s.duration, s.tolerance
+        "{}: {} of {} trials ({} engine), seed {}, {} s each{}, tolerance {:e}",
+        s.scenario,
+        s.trials_run,
+        s.trials,
+        s.engine,
+        s.seed,
+        s.duration,
+        s.until.map_or(String::new(), |m| format!(
+            " (--until settled, at most {m} s)"
+        )),
+        s.tolerance
     );
     let _ = writeln!(t, "{:<14} {:>8}", "outcome", "trials");
     for o in Outcome::ALL {
@@ -256,8 +280,21 @@ pub fn table(s: &McSummary, results: &[TrialResult]) -> String {
         "failure rate {}/{} = {:.4}; 95 % upper bound {:.4} (one-sided Clopper–Pearson), 95 % interval [{:.4}, {:.4}]",
         s.failures, s.trials_run, s.failure_rate, s.failure_rate_upper_95, lo, hi
     );
-    let _ = writeln!(t, "settle to 1e-3: {}", spread(results, |r| r.settle_1e3));
-    let _ = writeln!(t, "settle to 1e-6: {}", spread(results, |r| r.settle_1e6));
+    let _ = writeln!(
+        t,
+        "settle att < 1e-3: {}",
+        spread(results, |r| r.settle.att_1e3)
+    );
+    let _ = writeln!(
+        t,
+        "settle att < 1e-6: {}",
+        spread(results, |r| r.settle.att_1e6)
+    );
+    let _ = writeln!(
+        t,
+        "settle angvel < 1e-3 rad/s: {}",
+        spread(results, |r| r.settle.angvel_1e3)
+    );
     let worst = results
         .iter()
         .map(|r| r.final_max_att_err)
@@ -275,7 +312,11 @@ pub fn table(s: &McSummary, results: &[TrialResult]) -> String {
         } else {
             ""
         };
-        let _ = writeln!(t, "not converged: trials {}{more}", list.join(", "));
+        let _ = writeln!(
+            t,
+            "failed (neither converged nor converging): trials {}{more}",
+            list.join(", ")
+        );
     }
     t
 }

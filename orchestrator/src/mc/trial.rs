@@ -9,7 +9,9 @@ use super::seed::{trial_rng, trial_seed};
 use crate::interrupt::Interrupt;
 use crate::options::StiffnessCheck;
 use crate::processes::{self, ProcessError, ProcessOptions};
+use crate::run::Judging;
 use crate::scenario::{self, Loaded, ScenarioError};
+use crate::until;
 use attitude::engine::{InProcess, Snapshot};
 use std::path::{Path, PathBuf};
 
@@ -85,33 +87,47 @@ fn has_observer(p: &Prepared) -> bool {
         .is_some_and(|a| a.model.scheme.has_observer())
 }
 
-/// Runs trial `p` in-process on the calling thread, keeping only its trace.
+/// Runs trial `p` in-process on the calling thread, keeping only its
+/// trace; with `--until settled` its horizon is extended until the verdict
+/// is final ([`crate::until`]).
 #[must_use]
-pub fn run_in_process(p: &Prepared, tolerance: f64, interrupt: &Interrupt) -> Ran {
+pub fn run_in_process(p: &Prepared, judging: &Judging, interrupt: &Interrupt) -> Ran {
     let net = &p.loaded.resolved.network;
     let mut trace = Trace::new(net.dt, has_observer(p));
     let mut engine = InProcess::new(net);
+    let max = judging.max_steps(net.steps, net.dt);
     let mut stopped = false;
-    let on_sample = |snap: &Snapshot<'_>, _: &[()]| {
-        stopped = interrupt.is_set();
-        if !stopped {
-            trace.record(snap);
+    let diverged = loop {
+        let on_sample = |snap: &Snapshot<'_>, _: &[()]| {
+            stopped = interrupt.is_set();
+            if !stopped {
+                trace.record(snap);
+            }
+            !stopped
+        };
+        let diverged = engine.run_until(|_, _, _| (), on_sample, || interrupt.is_set());
+        let ended = stopped || diverged.is_some() || engine.step_index() < engine.horizon();
+        if ended || !until::goes_on(trace.verdict(judging).kind) || engine.horizon() >= max {
+            break diverged;
         }
-        !stopped
+        engine.extend_to(until::next_horizon(engine.horizon(), max, net.sample_every));
     };
-    let diverged = engine.run_until(|_, _, _| (), on_sample, || interrupt.is_set());
-    if stopped || (diverged.is_none() && engine.step_index() < net.steps) {
+    if stopped || (diverged.is_none() && engine.step_index() < engine.horizon()) {
         return Ran::Interrupted;
     }
     let end = match diverged {
-        Some(d) => End::Diverged(d.message(net, p.loaded.resolved.stiffness.as_ref())),
+        Some(d) => End::Diverged(
+            d.step as f64 * net.dt,
+            d.message(net, p.loaded.resolved.stiffness.as_ref()),
+        ),
         None => End::Complete,
     };
-    Ran::Done(classify(p.trial, p.seed, end, &trace, tolerance))
+    Ran::Done(classify(p.trial, p.seed, end, &trace, judging))
 }
 
 /// Runs trial `p` as processes (its own iceoryx2 namespace; node logs in
-/// `logs`), keeping only its trace.
+/// `logs`), keeping only its trace; with `--until settled` it runs again
+/// from t = 0 with a longer horizon until the verdict is final.
 ///
 /// # Errors
 /// The process engine could not start.
@@ -119,25 +135,34 @@ pub fn run_processes(
     p: &Prepared,
     opts: &ProcessOptions,
     logs: &Path,
-    tolerance: f64,
+    judging: &Judging,
     interrupt: &Interrupt,
 ) -> Result<Ran, ProcessError> {
-    let net = &p.loaded.resolved.network;
+    let mut net = p.loaded.resolved.network.clone();
+    let max = judging.max_steps(net.steps, net.dt);
     let mut trace = Trace::new(net.dt, has_observer(p));
     let mut opts = opts.clone();
     opts.plugins = p.loaded.resolved.plugins.clone();
-    let outcome = processes::run(net, &opts, logs, interrupt.flag(), |snap| {
-        trace.record(snap);
-        true
-    })?;
-    if interrupt.is_set() {
-        return Ok(Ran::Interrupted);
+    loop {
+        trace.clear();
+        let outcome = processes::run(&net, &opts, logs, interrupt.flag(), |snap| {
+            trace.record(snap);
+            true
+        })?;
+        if interrupt.is_set() {
+            return Ok(Ran::Interrupted);
+        }
+        let stiffness = p.loaded.resolved.stiffness.as_ref();
+        let end = match (outcome.diverged, outcome.failure) {
+            (Some(d), _) => End::Diverged(d.step as f64 * net.dt, d.message(&net, stiffness)),
+            (None, Some(why)) => End::Failed(why),
+            (None, None) => End::Complete,
+        };
+        let again =
+            end == End::Complete && until::goes_on(trace.verdict(judging).kind) && net.steps < max;
+        if !again {
+            return Ok(Ran::Done(classify(p.trial, p.seed, end, &trace, judging)));
+        }
+        net.steps = until::next_horizon(net.steps, max, net.sample_every);
     }
-    let stiffness = p.loaded.resolved.stiffness.as_ref();
-    let end = match (outcome.diverged, outcome.failure) {
-        (Some(d), _) => End::Diverged(d.message(net, stiffness)),
-        (None, Some(why)) => End::Failed(why),
-        (None, None) => End::Complete,
-    };
-    Ok(Ran::Done(classify(p.trial, p.seed, end, &trace, tolerance)))
 }

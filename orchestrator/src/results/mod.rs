@@ -205,6 +205,12 @@ impl Recorder {
         Ok(())
     }
 
+    /// The series recorded so far.
+    #[must_use]
+    pub fn series(&self) -> &[Series] {
+        &self.series
+    }
+
     /// Flushes the CSV and `states.bin` and returns the series.
     pub fn finish(mut self) -> Result<Vec<Series>, WriteError> {
         let (states, csv) = (self.files.states(), self.files.errors_csv());
@@ -226,8 +232,7 @@ pub fn agent_summaries(series: &[Series], peak_torques: &[f64]) -> Vec<AgentSumm
             final_angvel_err: s.angvel.last().copied().unwrap_or(f64::NAN),
             final_obs_att_err: s.obs_att.last().copied(),
             final_obs_angvel_err: s.obs_angvel.last().copied(),
-            settle_time_1e3: summary::settle_time(&s.t, &s.att, 1e-3),
-            settle_time_1e6: summary::settle_time(&s.t, &s.att, 1e-6),
+            settle: summary::Settle::of(&s.t, &s.att, &s.angvel),
             peak_torque,
             late_stages: None,
             max_lateness: None,

@@ -18,12 +18,9 @@ pub struct AgentSummary {
     pub final_obs_att_err: Option<f64>,
     /// Observer angular-velocity error at the last sample (schemes 1–2).
     pub final_obs_angvel_err: Option<f64>,
-    /// Time after which `att_err` stays below 1e-3 (null: not by the end).
-    #[serde(rename = "settle_time_1e-3")]
-    pub settle_time_1e3: Option<f64>,
-    /// Time after which `att_err` stays below 1e-6 (null: not by the end).
-    #[serde(rename = "settle_time_1e-6")]
-    pub settle_time_1e6: Option<f64>,
+    /// Settle times of this agent's errors ([`Settle`]).
+    #[serde(flatten)]
+    pub settle: Settle,
     /// Largest `‖τᵢ‖` applied at the start of any step, N·m.
     #[serde(deserialize_with = "f64_or_nan")]
     pub peak_torque: f64,
@@ -36,6 +33,62 @@ pub struct AgentSummary {
     /// The program that ran this agent, if it was a plug-in.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plugin: Option<String>,
+}
+
+/// Settle times, s: for each quantity and threshold, the time after which
+/// the quantity stays below the threshold to the end of the run
+/// ([`attsync_verdict::settle_time`], the one definition `run`, `sweep` and
+/// `mc` share; `null`: not by the end). The attitude error `|Rᵢ R₀ᵀ|_I` is
+/// dimensionless, the angular-velocity error `‖ωᵢ − ω₀‖` in rad/s.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Settle {
+    /// `|Rᵢ R₀ᵀ|_I < 1e-3`, s.
+    #[serde(rename = "settle_att_1e-3_s", default)]
+    pub att_1e3: Option<f64>,
+    /// `|Rᵢ R₀ᵀ|_I < 1e-6`, s.
+    #[serde(rename = "settle_att_1e-6_s", default)]
+    pub att_1e6: Option<f64>,
+    /// `‖ωᵢ − ω₀‖ < 1e-3 rad/s`, s.
+    #[serde(rename = "settle_angvel_1e-3_s", default)]
+    pub angvel_1e3: Option<f64>,
+    /// `‖ωᵢ − ω₀‖ < 1e-6 rad/s`, s.
+    #[serde(rename = "settle_angvel_1e-6_s", default)]
+    pub angvel_1e6: Option<f64>,
+}
+
+impl Settle {
+    /// The settle times of the attitude errors `att` and angular-velocity
+    /// errors `angvel` sampled at `t`.
+    #[must_use]
+    pub fn of(t: &[f64], att: &[f64], angvel: &[f64]) -> Self {
+        use attsync_verdict::settle_time;
+        Self {
+            att_1e3: settle_time(t, att, 1e-3),
+            att_1e6: settle_time(t, att, 1e-6),
+            angvel_1e3: settle_time(t, angvel, 1e-3),
+            angvel_1e6: settle_time(t, angvel, 1e-6),
+        }
+    }
+
+    /// The latest of several (`None` if any is `None`): when every one has settled.
+    #[must_use]
+    pub fn latest<'a>(all: impl IntoIterator<Item = &'a Settle>) -> Settle {
+        let max = |a: Option<f64>, b: Option<f64>| a.zip(b).map(|(a, b)| a.max(b));
+        all.into_iter().fold(
+            Settle {
+                att_1e3: Some(0.0),
+                att_1e6: Some(0.0),
+                angvel_1e3: Some(0.0),
+                angvel_1e6: Some(0.0),
+            },
+            |m, s| Settle {
+                att_1e3: max(m.att_1e3, s.att_1e3),
+                att_1e6: max(m.att_1e6, s.att_1e6),
+                angvel_1e3: max(m.angvel_1e3, s.angvel_1e3),
+                angvel_1e6: max(m.angvel_1e6, s.angvel_1e6),
+            },
+        )
+    }
 }
 
 /// Counters of one directed link. Listed: impaired links, every link in
@@ -112,6 +165,14 @@ pub struct Summary {
     /// the processes engine).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threads: Option<usize>,
+    /// The verdict on the run, read from the largest attitude error over
+    /// agents over the whole run (`docs/verdicts.md`); absent in summaries
+    /// written before verdicts existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<attsync_verdict::Verdict>,
+    /// `--until settled`: how far the horizon was extended and why it stopped.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub until: Option<crate::until::UntilSummary>,
 }
 
 /// Where a run diverged: the first state outside the envelope
@@ -199,18 +260,6 @@ fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
-/// Time after which `err` stays below `threshold`: the sample after the last
-/// one at or above it; `Some(t[0])` if always below; `None` if the last
-/// sample is not below.
-#[must_use]
-pub fn settle_time(t: &[f64], err: &[f64], threshold: f64) -> Option<f64> {
-    match err.iter().rposition(|&e| e >= threshold || e.is_nan()) {
-        None => t.first().copied(),
-        Some(k) if k + 1 < t.len() => Some(t[k + 1]),
-        Some(_) => None,
-    }
-}
-
 impl Summary {
     /// A fixed-width table of the per-agent results.
     #[must_use]
@@ -220,27 +269,42 @@ impl Summary {
         let time = |x: Option<f64>| x.map_or("never".to_string(), |v| format!("{v:.2}"));
         let _ = writeln!(
             s,
-            "{:>5} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10}",
+            "{:>5} {:>10} {:>12} {:>10} {:>12} {:>14} {:>14} {:>16} {:>12}",
             "agent",
             "att_err",
             "angvel_err",
             "obs_att",
             "obs_angvel",
-            "t<1e-3",
-            "t<1e-6",
+            "settle_att",
+            "settle_att",
+            "settle_angvel",
             "peak_tau"
+        );
+        let _ = writeln!(
+            s,
+            "{:>5} {:>10} {:>12} {:>10} {:>12} {:>14} {:>14} {:>16} {:>12}",
+            "",
+            "[1]",
+            "[rad/s]",
+            "[1]",
+            "[rad/s]",
+            "<1e-3 [s]",
+            "<1e-6 [s]",
+            "<1e-3 rad/s [s]",
+            "[N m]"
         );
         for a in &self.agents {
             let _ = writeln!(
                 s,
-                "{:>5} {:>10.3e} {:>10.3e} {:>10} {:>10} {:>9} {:>9} {:>10.3e}",
+                "{:>5} {:>10.3e} {:>12.3e} {:>10} {:>12} {:>14} {:>14} {:>16} {:>12.3e}",
                 a.id,
                 a.final_att_err,
                 a.final_angvel_err,
                 opt(a.final_obs_att_err),
                 opt(a.final_obs_angvel_err),
-                time(a.settle_time_1e3),
-                time(a.settle_time_1e6),
+                time(a.settle.att_1e3),
+                time(a.settle.att_1e6),
+                time(a.settle.angvel_1e3),
                 a.peak_torque
             );
         }
@@ -273,8 +337,56 @@ impl Summary {
                 )
             }
         );
+        if let Some(v) = &self.verdict {
+            let _ = write!(s, "\nverdict: {}", verdict_line(v));
+        }
+        if let Some(u) = &self.until {
+            let _ = write!(
+                s,
+                "\n--until settled: {} s in {} chunk(s), {}",
+                u.duration,
+                u.chunks,
+                match u.stopped {
+                    crate::until::Stopped::VerdictFinal =>
+                        "stopped when the verdict was final".to_string(),
+                    crate::until::Stopped::MaxDuration => format!(
+                        "stopped at --max-duration {} s before the verdict was final",
+                        u.max_duration
+                    ),
+                    crate::until::Stopped::RunEnded => "stopped when the run ended".to_string(),
+                }
+            );
+        }
         s
     }
+}
+
+/// One line for a verdict: its kind, the decay rate and what follows from it.
+#[must_use]
+pub fn verdict_line(v: &attsync_verdict::Verdict) -> String {
+    use attsync_verdict::Kind;
+    let rate = v
+        .decay_rate
+        .map_or(String::new(), |r| format!(", decay rate {r:.4} /s"));
+    let extra = match v.kind {
+        Kind::Converged => v.settle_time.map_or(String::new(), |t| {
+            format!(", below {:e} from t = {t} s", v.tolerance)
+        }),
+        Kind::Converging => v.projected_time.map_or(String::new(), |t| {
+            format!(
+                ", projected below {:e} at t ≈ {t:.1} s (--until settled runs on)",
+                v.tolerance
+            )
+        }),
+        Kind::Persistent => format!(
+            ", amplitude {}{}",
+            v.amplitude.map_or("?".into(), |a| format!("{a:.3e}")),
+            v.period
+                .map_or(String::new(), |p| format!(", period {p:.3} s"))
+        ),
+        Kind::Diverging | Kind::Undecided => String::new(),
+    };
+    format!("{}{rate}{extra} — {}", v.kind.name(), v.reason)
 }
 
 #[cfg(test)]
@@ -289,8 +401,7 @@ mod nan_tests {
             final_angvel_err: 0.5,
             final_obs_att_err: None,
             final_obs_angvel_err: None,
-            settle_time_1e3: None,
-            settle_time_1e6: None,
+            settle: Settle::default(),
             peak_torque: f64::NAN,
             late_stages: None,
             max_lateness: None,
@@ -301,18 +412,5 @@ mod nan_tests {
         let b: AgentSummary = serde_json::from_str(&text).unwrap();
         assert!(b.final_att_err.is_nan() && b.peak_torque.is_nan());
         assert_eq!(b.final_angvel_err, 0.5);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::settle_time;
-
-    #[test]
-    fn settle_time_is_the_sample_after_the_last_excursion() {
-        let t = [0.0, 1.0, 2.0, 3.0];
-        assert_eq!(settle_time(&t, &[1.0, 1e-4, 2e-3, 1e-4], 1e-3), Some(3.0));
-        assert_eq!(settle_time(&t, &[1e-4; 4], 1e-3), Some(0.0));
-        assert_eq!(settle_time(&t, &[1e-4, 1e-4, 1e-4, 1.0], 1e-3), None);
     }
 }

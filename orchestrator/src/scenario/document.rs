@@ -24,6 +24,18 @@ impl Document {
             sets: sets.to_vec(),
         }
     }
+
+    /// This document with one more override `set` (`key.path=value`),
+    /// which must apply (a field the scenario already validated).
+    #[must_use]
+    pub fn with_set(&self, set: String) -> Self {
+        let mut sets = self.sets.clone();
+        sets.push(set);
+        Self {
+            text: self.text.clone(),
+            sets,
+        }
+    }
 }
 
 impl Serialize for Document {

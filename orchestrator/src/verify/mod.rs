@@ -194,6 +194,9 @@ fn options(
         // The re-run is compared by states.bin and errors.csv only.
         view: false,
         hosts: None,
+        // A run `--until settled` extended recorded its final horizon in
+        // its scenario.toml: the re-run goes exactly that far.
+        judging: run::Judging::default(),
     })
 }
 

@@ -1,7 +1,7 @@
 //! `attsync mc`: a Monte Carlo over initial conditions, or one of its
 //! trials alone (`--trial K`).
 
-use super::{ScenarioArgs, WaitArg};
+use super::{ScenarioArgs, UntilArgs, WaitArg};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::mc::{self, McOptions, report};
@@ -39,9 +39,13 @@ pub struct Mc {
     /// Longest wait of a node for one stage's inputs, s (processes engine).
     #[arg(long, default_value_t = 10.0)]
     pub stage_timeout: f64,
-    /// Converged: complete, and every agent's final attitude error |R_i R_0^T|_I and angular-velocity error (rad/s) below this.
+    /// Converged: the largest attitude error |R_i R_0^T|_I over agents below
+    /// this and staying there (the verdict, docs/verdicts.md); a trial fails
+    /// when it is neither converged nor converging.
     #[arg(long, default_value_t = mc::options::DEFAULT_TOLERANCE)]
     pub tolerance: f64,
+    #[command(flatten)]
+    pub until: UntilArgs,
     /// Results directory [default: results/<scenario name>-mc].
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -77,7 +81,11 @@ pub fn exec(a: Mc, interrupt: &Interrupt) -> Result<(), Error> {
             stage_timeout: a.stage_timeout,
             ..ProcessOptions::default()
         },
-        tolerance: a.tolerance,
+        judging: {
+            let net = &loaded.resolved.network;
+            a.until
+                .judging(a.tolerance, net.steps as f64 * net.dt, false)
+        },
         out: (a.out.clone()).unwrap_or_else(|| mc::options::default_out(&loaded.name())),
         progress: !a.quiet && std::io::stderr().is_terminal(),
         stiffness: check,

@@ -6,6 +6,7 @@ mod conform;
 mod export;
 mod r#gen;
 mod host;
+mod margin;
 mod mc;
 mod run;
 mod sweep;
@@ -45,6 +46,12 @@ pub enum Command {
     /// attitudes and random rates, each classified; the failure rate with
     /// its exact 95 % bound. `--trial K` reruns one trial alone.
     Mc(mc::Mc),
+    /// The delay margin of the closed loop linearised about synchronisation
+    /// (schemes 2 and 3): the smallest common link delay at which a
+    /// characteristic root crosses the imaginary axis, the crossing
+    /// frequency, and the rightmost root at the scenario's own delay (the
+    /// decay rate a run should show). docs/verdicts.md.
+    Margin(margin::MarginCmd),
     /// Write a run directory's view.html again (the run in 3D, in any
     /// browser, offline) from its scenario.toml, summary.json and states.bin.
     View(view::View),
@@ -69,6 +76,7 @@ pub fn exec(command: Command) -> Result<(), Error> {
         Command::Export(a) => export::exec(a),
         Command::Gen(a) => r#gen::exec(a),
         Command::Mc(a) => mc::exec(a, &interrupt()?),
+        Command::Margin(a) => margin::exec(a),
         Command::View(a) => view::exec(a),
         Command::Verify(a) => verify::exec(a, &interrupt()?),
         Command::Host(a) => host::exec(a, &interrupt()?),
@@ -108,6 +116,46 @@ impl ScenarioArgs {
             &self.overrides.set,
             check,
         )?)
+    }
+}
+
+/// `--until` and `--max-duration`, shared by `run`, `sweep` and `mc`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct UntilArgs {
+    /// How long each run goes: `horizon` = the scenario's simulation.duration;
+    /// `settled` = extend it (doubling) until the verdict is final —
+    /// converged, persistent or diverging, not converging or undecided
+    /// (docs/verdicts.md) — at most --max-duration.
+    #[arg(long, value_enum, default_value_t = UntilArg::Horizon)]
+    pub until: UntilArg,
+    /// With --until settled (and sweep --find-margin): the longest horizon, s
+    /// [default: 16 × simulation.duration].
+    #[arg(long, value_name = "SECONDS")]
+    pub max_duration: Option<f64>,
+}
+
+/// `--until`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum UntilArg {
+    /// The scenario's simulation.duration.
+    Horizon,
+    /// Until the verdict is final (or --max-duration).
+    Settled,
+}
+
+impl UntilArgs {
+    /// What a run is judged by, for a scenario of `duration` seconds
+    /// (`settle`: until settled whatever `--until` says, as `sweep
+    /// --find-margin` needs).
+    pub fn judging(&self, tolerance: f64, duration: f64, settle: bool) -> attsync::run::Judging {
+        use attsync::until::{DEFAULT_MAX_FACTOR, Until};
+        let until = match self.until {
+            UntilArg::Horizon if !settle => Until::Horizon,
+            _ => Until::Settled {
+                max_duration: self.max_duration.unwrap_or(DEFAULT_MAX_FACTOR * duration),
+            },
+        };
+        attsync::run::Judging { tolerance, until }
     }
 }
 

@@ -1,6 +1,6 @@
 //! `attsync run`: a scenario through an engine into a results directory.
 
-use super::{EngineArgs, HostsArgs, ScenarioArgs};
+use super::{EngineArgs, HostsArgs, ScenarioArgs, UntilArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::options::StiffnessCheck;
@@ -10,7 +10,8 @@ use std::path::PathBuf;
 
 /// `attsync run SCENARIO [--engine E] [--wait W] [--stage-timeout S]
 /// [--realtime [FACTOR]] [--threads N] [--hosts HOSTS.toml] [--out DIR]
-/// [--set K=V]… [--quiet] [--no-stiffness-check] [--no-view]`.
+/// [--set K=V]… [--quiet] [--no-stiffness-check] [--no-view] [--tolerance E]
+/// [--until horizon|settled] [--max-duration S]`.
 #[derive(Debug, clap::Args)]
 pub struct Run {
     #[command(flatten)]
@@ -44,6 +45,12 @@ pub struct Run {
     /// DIR` writes it later from the results).
     #[arg(long)]
     pub no_view: bool,
+    /// Converged: the largest attitude error |R_i R_0^T|_I over agents below
+    /// this and staying there (the verdict, docs/verdicts.md).
+    #[arg(long, default_value_t = attsync::until::DEFAULT_TOLERANCE)]
+    pub tolerance: f64,
+    #[command(flatten)]
+    pub until: UntilArgs,
 }
 
 /// Runs the scenario, prints its summary; an incomplete run is an error
@@ -58,11 +65,16 @@ pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
         threads: a.threads.unwrap_or_else(run::default_threads),
         view: !a.no_view,
         hosts,
+        judging: a.until.judging(a.tolerance, 1.0, false),
     };
     opts.validate()?;
     let loaded = a
         .scenario
         .load(StiffnessCheck::from_flag(a.no_stiffness_check))?;
+    let net = &loaded.resolved.network;
+    opts.judging = a
+        .until
+        .judging(a.tolerance, net.steps as f64 * net.dt, false);
     for w in &loaded.resolved.warnings {
         eprintln!("warning: {}: {w}", loaded.file.display());
     }

@@ -1,7 +1,7 @@
 //! `attsync sweep`: one field of a scenario over many values, in parallel,
 //! and optionally the bisection for the margin.
 
-use super::{EngineArgs, HostsArgs, ScenarioArgs};
+use super::{EngineArgs, HostsArgs, ScenarioArgs, UntilArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::options::StiffnessCheck;
@@ -33,10 +33,16 @@ pub struct Sweep {
     /// Sweep directory [default: results/<scenario name>-sweep-<param>].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Converged: complete, and every agent's final attitude error below this.
-    #[arg(long, default_value_t = 1e-3)]
+    /// Converged: the largest attitude error |R_i R_0^T|_I over agents below
+    /// this and staying there (the verdict, docs/verdicts.md).
+    #[arg(long, default_value_t = attsync::until::DEFAULT_TOLERANCE)]
     pub tolerance: f64,
-    /// Bisect between the first value that does not converge and the one before it (the first must converge).
+    #[command(flatten)]
+    pub until: UntilArgs,
+    /// Bisect between the first value whose error does not decay (persistent
+    /// or diverging) and the one before it (whose error must decay), every
+    /// run extended until its verdict is final (--until settled unless
+    /// given); for network.delay the linearisation's margin is put beside it.
     #[arg(long)]
     pub find_margin: bool,
     /// Bisection iterations.
@@ -69,8 +75,8 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
             threads,
             view: false,
             hosts,
+            judging: a.until.judging(a.tolerance, 1.0, a.find_margin),
         },
-        tolerance: a.tolerance,
         find_margin: a.find_margin.then_some(Bisection {
             iterations: a.bisect,
             quantum: a.quantum,
@@ -79,6 +85,10 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
     };
     o.validate()?;
     let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
+    let net = &base.resolved.network;
+    o.run.judging = a
+        .until
+        .judging(a.tolerance, net.steps as f64 * net.dt, a.find_margin);
     if let Some(h) = &o.run.hosts {
         // Every run places its own scenario again; the base, before any starts.
         attsync::hosts::Placement::of(h, &base.resolved.network)?;

@@ -1,9 +1,15 @@
 //! `attsync sweep`: one scenario over a list of values of one field, runs in
-//! parallel (each isolated), and the bisection that finds the largest value
-//! that still converges.
+//! parallel (each isolated), and the bisection that finds the stability
+//! boundary (`--find-margin`).
 //!
-//! Convergence criterion: the run completes and every agent's attitude error
-//! `|Rᵢ R₀ᵀ|_I` at the end of the run is below `tolerance` (default 1e-3).
+//! Each run is judged by its verdict (`docs/verdicts.md`, `attsync_verdict`):
+//! read from the largest attitude error over agents over the whole run, not
+//! from its last sample; `converged` still means below `--tolerance`.
+//! `--find-margin` bisects on whether the error decays (`converged` or
+//! `converging`; an `undecided` run by the sign of its decay rate), with
+//! every run extended until its verdict is final (`--until settled`), and
+//! puts the linearisation's exact margin (`attsync margin`,
+//! `attitude::linear`) beside the bracket it finds ([`margin`]).
 //!
 //! Policy (all here, where tests reach it): every value must make a valid
 //! scenario before anything runs ([`load_checked`], exit code 2 like an
@@ -12,14 +18,21 @@
 //! `--jobs` × `--threads` stays within the cores unless both are given
 //! ([`jobs_and_threads`]).
 
+mod files;
+pub mod margin;
+mod plot;
+
+pub use files::{CSV_HEADER, table};
+pub use margin::{LinearMargin, MarginResult};
+
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError, StiffnessCheck};
 use crate::results::layout::SweepLayout;
 use crate::results::staging::Staging;
+use crate::results::summary::Settle;
 use crate::run::{Engine, RunError, RunOptions, run};
 use crate::scenario::{self, Loaded, ScenarioError};
-use plotters::prelude::*;
-use std::fmt::Write as _;
+use attsync_verdict::{Kind, Verdict};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use thiserror::Error;
@@ -39,8 +52,6 @@ pub struct SweepOptions {
     pub set: Vec<String>,
     /// Engine and output options of each run (`out` is the sweep directory).
     pub run: RunOptions,
-    /// Convergence tolerance on the final attitude error (> 0).
-    pub tolerance: f64,
     /// Bisect between the first value that does not converge and the one
     /// before it, for the margin.
     pub find_margin: Option<Bisection>,
@@ -59,14 +70,13 @@ pub struct Bisection {
 }
 
 impl SweepOptions {
-    /// Checks `--jobs`, `--tolerance`, `--bisect`, `--quantum` and the
-    /// options of every run ([`RunOptions::validate`]).
+    /// Checks `--jobs`, `--bisect`, `--quantum` and the options of every
+    /// run ([`RunOptions::validate`]: `--tolerance`, `--max-duration` too).
     ///
     /// # Errors
     /// The first option out of its range.
     pub fn validate(&self) -> Result<(), OptionError> {
         options::count("--jobs", self.jobs as u64, 1, u64::MAX)?;
-        options::positive("--tolerance", self.tolerance)?;
         if let Some(b) = self.find_margin {
             options::count(
                 "--bisect",
@@ -230,14 +240,37 @@ pub struct SweepRow {
     pub value: String,
     /// Largest final attitude error over agents.
     pub final_max_att_err: f64,
-    /// Time after which every agent's attitude error stays below 1e-3 (None: not by the end).
-    pub time_to_1e3: Option<f64>,
-    /// The convergence criterion.
+    /// When every agent had settled ([`Settle::latest`] of the agents').
+    pub settle: Settle,
+    /// The run's verdict.
+    pub verdict: Verdict,
+    /// The horizon the run ended with, s (longer than the scenario's when
+    /// `--until settled` extended it).
+    pub duration: f64,
+    /// The verdict is `converged` (below `--tolerance` and staying there).
     pub converged: bool,
     /// Whether the run reached its horizon.
     pub complete: bool,
+    /// The real part of the rightmost root of the run's linearisation
+    /// (`attitude::linear`), 1/s: the decay rate it predicts; `None` where
+    /// the scenario cannot be linearised.
+    pub linear_rate: Option<f64>,
     /// Results directory of the run, relative to the sweep directory.
     pub dir: String,
+}
+
+impl SweepRow {
+    /// Whether the run's error decays: `converged` or `converging`;
+    /// `undecided` by the sign of its decay rate; `persistent`,
+    /// `diverging` and a failed run do not.
+    #[must_use]
+    pub fn decays(&self) -> bool {
+        match self.verdict.kind {
+            Kind::Converged | Kind::Converging => self.complete,
+            Kind::Persistent | Kind::Diverging => false,
+            Kind::Undecided => self.complete && self.verdict.decay_rate.is_some_and(|r| r < 0.0),
+        }
+    }
 }
 
 /// The sweep's result.
@@ -245,8 +278,8 @@ pub struct SweepRow {
 pub struct SweepResult {
     /// Rows, in value order of execution (listed values first, then bisection).
     pub rows: Vec<SweepRow>,
-    /// Largest value found to converge by bisection, and the smallest that did not.
-    pub margin: Option<(f64, f64)>,
+    /// `--find-margin`: the bracket found by bisection and the linear margin.
+    pub margin: Option<MarginResult>,
 }
 
 fn run_one(
@@ -272,17 +305,23 @@ fn run_one(
         value: value.to_string(),
         source,
     })?;
-    let time_to_1e3 = s
-        .agents
-        .iter()
-        .map(|a| a.settle_time_1e3)
-        .try_fold(0.0_f64, |m, t| t.map(|t| m.max(t)));
+    let linear_rate = attitude::linear::Linearisation::of(&loaded.resolved.network)
+        .ok()
+        .map(|l| l.rightmost().re);
+    let settle = Settle::latest(s.agents.iter().map(|a| &a.settle));
+    let verdict = s
+        .verdict
+        .clone()
+        .unwrap_or_else(|| o.run.judging.verdict(&[]));
     Ok(SweepRow {
         value: value.to_string(),
         final_max_att_err: s.max_final_att_err,
-        time_to_1e3,
-        converged: s.complete && s.agents.iter().all(|a| a.final_att_err < o.tolerance),
+        settle,
+        converged: verdict.kind == Kind::Converged,
+        verdict,
+        duration: s.duration,
         complete: s.complete,
+        linear_rate,
         dir: format!("runs/{name}"),
     })
 }
@@ -341,6 +380,7 @@ fn run_many(
 pub fn sweep(o: &SweepOptions, interrupt: &Interrupt) -> Result<SweepResult, SweepError> {
     o.validate()?;
     let base = load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
+    let o = &margin::settled_for_margin(o, &base);
     interrupt.arm();
     let staging = Staging::new(&o.run.out).map_err(io_at(&o.run.out))?;
     let dir = staging.path().to_owned();
@@ -350,38 +390,34 @@ pub fn sweep(o: &SweepOptions, interrupt: &Interrupt) -> Result<SweepResult, Swe
             let quantum = b
                 .quantum
                 .or_else(|| default_quantum(&o.param, base.resolved.network.dt));
-            Some(bisect(
-                o,
-                &dir,
-                &mut rows,
-                b.iterations,
-                quantum,
-                interrupt,
-            )?)
+            let (lo, hi) = bisect(o, &dir, &mut rows, b.iterations, quantum, interrupt)?;
+            Some(margin::result(&o.param, &base, lo, hi, quantum))
         }
         None => None,
     };
-    write_files(o, &dir, &rows, margin)?;
+    files::write(o, &base, &dir, &rows, margin.as_ref())?;
     staging.commit().map_err(io_at(&o.run.out))?;
     Ok(SweepResult { rows, margin })
 }
 
-/// The bracket: the first value that does not converge and the one before it.
+/// The bracket: the first value whose error does not decay and the one before it.
 fn bracket(o: &SweepOptions, rows: &[SweepRow]) -> Result<(f64, f64), SweepError> {
     let parse = |v: &str| {
         v.parse::<f64>()
             .map_err(|_| SweepError::Margin(format!("numeric values, got {v:?}")))
     };
-    let Some(k) = rows.iter().position(|r| !r.converged) else {
+    let Some(k) = rows.iter().position(|r| !r.decays()) else {
         return Err(SweepError::Margin(format!(
-            "a value that does not converge: every value of {} converges",
+            "a value whose error does not decay: the error decays for every value of {}",
             o.param
         )));
     };
     if k == 0 {
         return Err(SweepError::Margin(format!(
-            "the first value to converge: {} = {} does not",
-            o.param, rows[0].value
+            "a first value whose error decays: at {} = {} it is {}",
+            o.param,
+            rows[0].value,
+            rows[0].verdict.kind.name()
         )));
     }
     Ok((parse(&rows[k - 1].value)?, parse(&rows[k].value)?))
@@ -398,7 +434,8 @@ pub fn quantise(mid: f64, quantum: f64) -> f64 {
 }
 
 /// Bisects the bracket for `iterations` (fewer once the points, rounded to
-/// `quantum`, meet): the largest converging value and the smallest failing.
+/// `quantum`, meet): the largest value whose error decays and the smallest
+/// whose error does not.
 fn bisect(
     o: &SweepOptions,
     dir: &Path,
@@ -418,7 +455,7 @@ fn bisect(
         }
         let value = format!("{mid}");
         let row = run_many(o, dir, rows.len(), std::slice::from_ref(&value), interrupt)?.remove(0);
-        if row.converged {
+        if row.decays() {
             lo = mid;
         } else {
             hi = mid;
@@ -426,133 +463,6 @@ fn bisect(
         rows.push(row);
     }
     Ok((lo, hi))
-}
-
-/// `sweep.csv`, `sweep.json`, `sweep.svg` and the staging marker.
-fn write_files(
-    o: &SweepOptions,
-    dir: &Path,
-    rows: &[SweepRow],
-    margin: Option<(f64, f64)>,
-) -> Result<(), SweepError> {
-    let mut csv = String::from("value,final_max_att_err,time_to_1e-3,converged,complete,run\n");
-    for r in rows {
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{}",
-            r.value,
-            r.final_max_att_err,
-            r.time_to_1e3.map_or(String::new(), |t| t.to_string()),
-            r.converged,
-            r.complete,
-            r.dir
-        );
-    }
-    let layout = SweepLayout::new(dir);
-    let file = layout.csv();
-    std::fs::write(&file, csv).map_err(io_at(&file))?;
-    let info = serde_json::json!({
-        "param": o.param,
-        "criterion": format!("complete and every agent's final att_err < {}", o.tolerance),
-        "margin": margin.map(|(lo, hi)| serde_json::json!({"largest_converging": lo, "smallest_failing": hi})),
-    });
-    let info = serde_json::to_string_pretty(&info).expect("json") + "\n";
-    let file = layout.json();
-    std::fs::write(&file, &info).map_err(io_at(&file))?;
-    plot(&layout.svg(), &o.param, rows).map_err(SweepError::Plot)?;
-    let file = layout.summary();
-    std::fs::write(&file, &info).map_err(io_at(&file))
-}
-
-/// The table printed at the end.
-#[must_use]
-pub fn table(param: &str, r: &SweepResult) -> String {
-    let mut s = format!(
-        "{:>14} {:>16} {:>12} {:>9}\n",
-        param, "final_max_att", "t_to_1e-3", "converged"
-    );
-    for row in &r.rows {
-        let _ = writeln!(
-            s,
-            "{:>14} {:>16.3e} {:>12} {:>9}",
-            row.value,
-            row.final_max_att_err,
-            row.time_to_1e3
-                .map_or("never".into(), |t| format!("{t:.2}")),
-            if row.converged {
-                "yes"
-            } else if row.complete {
-                "no"
-            } else {
-                "FAILED"
-            }
-        );
-    }
-    if let Some((lo, hi)) = r.margin {
-        let _ = writeln!(s, "margin: {param} = {lo} converges, {hi} does not");
-    }
-    s
-}
-
-fn plot(file: &Path, param: &str, rows: &[SweepRow]) -> Result<(), String> {
-    let pts: Vec<(f64, f64, bool)> = rows
-        .iter()
-        .filter_map(|r| {
-            r.value
-                .parse::<f64>()
-                .ok()
-                .map(|v| (v, r.final_max_att_err.max(1e-16), r.converged))
-        })
-        .collect();
-    if pts.is_empty() {
-        return Ok(());
-    }
-    let (x0, x1) = pts
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-            (a.min(p.0), b.max(p.0))
-        });
-    let (x0, x1) = if x1 > x0 {
-        (x0, x1)
-    } else {
-        (x0 - 1.0, x1 + 1.0)
-    };
-    let root = SVGBackend::new(file, (900, 500)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let mut chart = ChartBuilder::on(&root)
-        .margin(15)
-        .caption(
-            format!("final max attitude error vs {param}"),
-            ("sans-serif", 18),
-        )
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, (1e-16f64..1.0).log_scale())
-        .map_err(|e| e.to_string())?;
-    chart
-        .configure_mesh()
-        .x_desc(param)
-        .y_label_formatter(&|v| format!("{v:.0e}"))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    let mut sorted = pts.clone();
-    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
-    chart
-        .draw_series(LineSeries::new(
-            sorted.iter().map(|p| (p.0, p.1)),
-            BLUE.stroke_width(2),
-        ))
-        .map_err(|e| e.to_string())?;
-    chart
-        .draw_series(pts.iter().map(|p| {
-            Circle::new(
-                (p.0, p.1),
-                5,
-                if p.2 { GREEN.filled() } else { RED.filled() },
-            )
-        }))
-        .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())
 }
 
 #[cfg(test)]
@@ -593,8 +503,8 @@ mod tests {
                 threads: 1,
                 view: false,
                 hosts: None,
+                judging: crate::run::Judging::default(),
             },
-            tolerance: 1e-3,
             find_margin: Some(Bisection {
                 iterations: 8,
                 quantum: None,
@@ -664,8 +574,8 @@ mod tests {
         assert_eq!(options().validate(), Ok(()));
         let cases: [(&str, Breaker); 7] = [
             ("--jobs", |o| o.jobs = 0),
-            ("--tolerance", |o| o.tolerance = f64::NAN),
-            ("--tolerance", |o| o.tolerance = 0.0),
+            ("--tolerance", |o| o.run.judging.tolerance = f64::NAN),
+            ("--tolerance", |o| o.run.judging.tolerance = 0.0),
             ("--bisect", |o| {
                 o.find_margin.as_mut().unwrap().iterations = 65
             }),
