@@ -7,6 +7,7 @@
 //! ./target/release/attsync-bench run --quick --out quick.md       # ~2 min, one repetition
 //! ./target/release/attsync-bench run --only tree-32 --reps 1      # one case
 //! ./target/release/attsync-bench scale --agents 10,100,1000 --threads 1,2   # in-process scale
+//! ./target/release/attsync-bench conclusions                       # attsync margin timings, --until settled overhead
 //! ```
 //! It needs `attsync`, `attsync-agent` and `attsync-leader` beside it (or
 //! `--bin-dir`), and the paper scenarios (`--scenarios`, default
@@ -36,6 +37,7 @@
 //!   load, the machine; [`error`]: [`error::BenchError`].
 
 mod bare;
+mod conclusions;
 mod error;
 mod hosts;
 mod measure;
@@ -98,6 +100,17 @@ enum Cmd {
     },
     /// (internal) A CPU-bound competitor of the contention case: spins until killed.
     Burn,
+    /// Issue 32: `attsync margin`'s wall time (paper scenarios, generated
+    /// trees) and what `--until settled` costs against one run of the same
+    /// final horizon (a Markdown report).
+    Conclusions {
+        /// Directory of the paper scenarios (default: scenarios/paper).
+        #[arg(long)]
+        scenarios: Option<PathBuf>,
+        /// Repetitions per measurement (medians).
+        #[arg(long, default_value_t = 3)]
+        reps: usize,
+    },
     /// In-process scale: agent-steps/s of the in-process engine against N
     /// agents and threads, per scheme (networks built in memory; a Markdown table).
     Scale {
@@ -258,6 +271,11 @@ fn main() -> ExitCode {
 fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
     match cmd {
         Cmd::Burn => suite::burn(),
+        Cmd::Conclusions { scenarios, reps } => {
+            let dir = scenarios.unwrap_or_else(|| PathBuf::from("scenarios/paper"));
+            print!("{}", conclusions::report(&dir, reps)?);
+            Ok(())
+        }
         Cmd::Hosts {
             scenario,
             duration,

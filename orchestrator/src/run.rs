@@ -376,7 +376,9 @@ fn drive_in_process(
 }
 
 /// The processes engine: its nodes are started for a fixed horizon, so
-/// `--until settled` runs again from t = 0 with the next horizon.
+/// `--until settled` first finds the final horizon in-process
+/// ([`until::settled_horizon`]), or, with plug-ins, runs again from t = 0
+/// with the next horizon while the verdict is not final.
 fn drive_processes(
     loaded: &Loaded,
     opts: &RunOptions,
@@ -390,6 +392,17 @@ fn drive_processes(
     process_opts.plugins = loaded.resolved.plugins.clone();
     process_opts.hosts = plan(loaded, opts)?;
     let mut chunks = 0;
+    // Without plug-ins the in-process engine finds the final horizon
+    // (bit-identical lockstep): the processes run once, to it.
+    let probe = matches!(opts.judging.until, Until::Settled { .. })
+        && loaded.resolved.plugins.is_empty()
+        && opts.processes.realtime.is_none();
+    if probe && let Some((horizon, probed)) = until::settled_horizon(&net, &opts.judging, interrupt)
+    {
+        net.steps = horizon;
+        bar.set_length(horizon);
+        chunks = probed - 1;
+    }
     loop {
         chunks += 1;
         let mut rec = Recording::start(loaded, opts, layout, bar)?;

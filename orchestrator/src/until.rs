@@ -9,13 +9,20 @@
 //! on from where it stopped ([`attitude::engine::InProcess::extend_to`]:
 //! the extended run is bit-identical to the run given its final horizon
 //! from the start); the processes engine starts its nodes for a fixed
-//! horizon, so it runs again from t = 0 with the doubled horizon (at most
-//! twice the work of its final run). Either way the results are exactly
+//! horizon, so the in-process engine finds that horizon first
+//! ([`settled_horizon`]: lockstep runs are bit-identical in every engine)
+//! and the processes run once to it — except with plug-ins, which only the
+//! processes engine runs: then it runs again from t = 0 with the doubled
+//! horizon (at most twice the work of its final run). Either way the results are exactly
 //! those of the scenario with `simulation.duration` = the final horizon,
 //! which is what the run's `scenario.toml` then says (so `verify` re-runs it).
 
+use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
 use crate::results::Series;
+use attitude::engine::{InProcess, Snapshot};
+use attitude::metrics::errors;
+use attitude::network::Network;
 use attsync_verdict::{Kind, Thresholds, Verdict};
 use serde::{Deserialize, Serialize};
 
@@ -124,6 +131,53 @@ pub fn largest_attitude_error(series: &[Series]) -> (Vec<f64>, Vec<f64>) {
         })
         .collect();
     (first.t.clone(), x)
+}
+
+/// The horizon `--until settled` ends with for `net`, and the number of
+/// chunks it took, found by the in-process engine extending one run —
+/// lockstep runs are bit-identical in every engine, so a processes run of
+/// that horizon reaches the same verdict, and need not run again from
+/// t = 0 for each doubling. `None` if `interrupt` stopped it, or the run
+/// diverged (the processes run will say where).
+#[must_use]
+pub fn settled_horizon(
+    net: &Network,
+    judging: &Judging,
+    interrupt: &Interrupt,
+) -> Option<(u64, u32)> {
+    let max = judging.max_steps(net.steps, net.dt);
+    let mut engine = InProcess::new(net);
+    let (mut t, mut x, mut chunks) = (Vec::new(), Vec::new(), 0);
+    loop {
+        chunks += 1;
+        let diverged = engine.run_until(
+            |_, _, _| (),
+            |snap: &Snapshot<'_>, _: &[()]| {
+                let largest = snap.agents.iter().fold(0.0_f64, |m, a| {
+                    let e = errors(a, snap.leader, false).att;
+                    if m.is_nan() || e.is_nan() {
+                        f64::NAN
+                    } else {
+                        m.max(e)
+                    }
+                });
+                let at = crate::results::fmt_time(snap.step, net.dt);
+                t.push(at.parse().expect("fmt_time prints a number"));
+                x.push(largest);
+                !interrupt.is_set()
+            },
+            || interrupt.is_set(),
+        );
+        if diverged.is_some() || engine.step_index() < engine.horizon() {
+            return None;
+        }
+        let kind =
+            attsync_verdict::classify(&t, &x, judging.tolerance, &Thresholds::default()).kind;
+        if !goes_on(kind) || engine.horizon() >= max {
+            return Some((engine.horizon(), chunks));
+        }
+        engine.extend_to(next_horizon(engine.horizon(), max, net.sample_every));
+    }
 }
 
 /// Why an extended run stopped (`summary.json` `until.stopped`).

@@ -33,7 +33,9 @@
 //! - [`eig`]: dense eigenvalues (real and complex QR with an iteration limit).
 //! - [`error`]: why a network is refused.
 
+mod blocks;
 pub mod cheb;
+pub mod contour;
 pub mod eig;
 pub mod error;
 pub mod margin;
@@ -41,9 +43,14 @@ pub mod model;
 pub mod profile;
 pub mod roots;
 pub mod system;
+pub mod tree;
+pub mod tree_margin;
+pub mod tree_roots;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tree_tests;
 
 pub use error::{Impairment, LinearError};
 pub use margin::Margin;

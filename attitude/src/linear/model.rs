@@ -30,21 +30,27 @@
 //! system of `6N`. States are ordered agent by agent, `[xᵢ, ωᵢ]`.
 
 use super::Root;
+use super::blocks::{self, Block, Body, Delays, diagonal};
 use super::error::{Impairment, LinearError};
 use super::margin::{self, Margin};
-use super::profile::Profile;
-use super::roots::{self, MIN_ORDER};
+use super::roots;
 use super::system::Dde;
+use super::tree_margin;
+use super::tree_roots::Search;
 use crate::link::Loss;
 use crate::network::{Coupling, Network, Scheme};
-use crate::stiffness::{psi_gain, quadratic_roots};
-use nalgebra::{Complex, DMatrix, Matrix3};
-use std::collections::BTreeMap;
+use nalgebra::Complex;
 
-/// The largest dense pseudospectral matrix computed ([`roots::size`]); a
-/// network whose first two orders do not fit is refused
+/// The largest dense pseudospectral matrix computed ([`roots::size`]): a
+/// network whose first two orders may not fit (counting every agent some
+/// agent hears as delayed) goes to the tree path ([`super::tree`]) if it
+/// splits per axis and its graph is a forest, else is refused
 /// ([`LinearError::TooLarge`]).
 pub const DENSE_LIMIT: usize = 1000;
+
+/// The most agents the tree path takes (`O(N)` memory and work per
+/// evaluation of `det Δ`; beyond, [`LinearError::TooLarge`]).
+pub const TREE_LIMIT: usize = 200_000;
 
 /// Which part of the closed loop a root belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -69,46 +75,12 @@ pub struct Rightmost {
     pub part: Part,
     /// The axis (0, 1, 2) of a per-axis system, `None` for a full one.
     pub axis: Option<usize>,
-    /// The Chebyshev order it was confirmed at (0: no delay, an eigenvalue).
+    /// The Chebyshev order it was confirmed at (0: no discretisation: no
+    /// delay, an eigenvalue; or the tree path, [`super::tree_roots`]).
     pub order: usize,
-    /// Whether two Chebyshev orders agreed on it ([`roots::Found`]).
+    /// Whether two Chebyshev orders agreed on it ([`roots::Found`]), or
+    /// (tree path) the count of roots right of it certified it.
     pub converged: bool,
-}
-
-/// One decoupled system: an axis (or all three), the own-state terms and,
-/// per follower-link delay in steps, the coupling terms.
-#[derive(Debug, Clone, PartialEq)]
-struct Block {
-    axis: Option<usize>,
-    a0: DMatrix<f64>,
-    links: BTreeMap<u64, DMatrix<f64>>,
-    /// `G(ω)` of the common-delay system ([`Profile`]).
-    profile: Profile,
-}
-
-impl Block {
-    /// The delay system at the network's own per-link delays.
-    fn own(&self, dt: f64) -> Dde {
-        let delayed = self
-            .links
-            .iter()
-            .map(|(&k, a)| (k as f64 * dt, a.clone()))
-            .collect();
-        Dde::new(self.a0.clone(), delayed)
-    }
-
-    /// Every coupling term together (`A₁`).
-    fn coupling(&self) -> DMatrix<f64> {
-        let n = self.a0.nrows();
-        self.links
-            .values()
-            .fold(DMatrix::zeros(n, n), |acc, a| acc + a)
-    }
-
-    /// The delay system with every follower link delayed by `d`.
-    fn common(&self, d: f64) -> Dde {
-        Dde::new(self.a0.clone(), vec![(d, self.coupling())])
-    }
 }
 
 /// The closed loop linearised about synchronisation, with its delays.
@@ -120,17 +92,6 @@ pub struct Linearisation {
     blocks: Vec<Block>,
     /// Scheme 2: every tracking root (`Im ≥ 0`), its agent and axis.
     tracking: Vec<(Complex<f64>, u32, Option<usize>)>,
-}
-
-/// Whether `m` is diagonal (off-diagonal entries exactly 0).
-fn diagonal(m: &Matrix3<f64>) -> bool {
-    (0..3).all(|i| (0..3).all(|j| i == j || m[(i, j)] == 0.0))
-}
-
-/// Adds `v` to the `b × b` block of `m` at block row `r`, block column `c`.
-fn add(m: &mut DMatrix<f64>, b: usize, r: usize, c: usize, v: &DMatrix<f64>) {
-    let mut blk = m.view_mut((r * b, c * b), (b, b));
-    blk += v;
 }
 
 impl Linearisation {
@@ -184,142 +145,65 @@ impl Linearisation {
         Self::build(net, part, loop_gains, split)
     }
 
-    /// [`Self::of`] after the checks: per axis if `split`, else one system.
+    /// [`Self::of`] after the checks: per axis if `split`, else one system;
+    /// dense while the discretisation fits ([`blocks::dense_size`]), else
+    /// the tree path.
     fn build(
         net: &Network,
         part: Part,
-        (k_r, k_w): (f64, f64),
+        gains: (f64, f64),
         split: bool,
     ) -> Result<Self, LinearError> {
-        let n_agents = net.agents.len();
-        let b = if split { 1 } else { 3 };
-        let states = 2 * b * n_agents;
-        let index = net.index_by_id();
-        let axes: Vec<Option<usize>> = if split {
-            vec![Some(0), Some(1), Some(2)]
+        let size = blocks::dense_size(net, part == Part::Observer, split);
+        let blocks = if size <= DENSE_LIMIT {
+            blocks::dense(net, part == Part::Observer, gains, split)
         } else {
-            vec![None]
-        };
-        let mut blocks = Vec::with_capacity(axes.len());
-        for &axis in &axes {
-            let proj = |m: &Matrix3<f64>| -> DMatrix<f64> {
-                match axis {
-                    Some(k) => DMatrix::from_element(1, 1, m[(k, k)]),
-                    None => DMatrix::from_column_slice(3, 3, m.as_slice()),
-                }
+            let too_large = LinearError::TooLarge {
+                states: size,
+                limit: DENSE_LIMIT,
             };
-            let eye = proj(&Matrix3::identity());
-            let mut a0 = DMatrix::zeros(states, states);
-            let mut links: BTreeMap<u64, DMatrix<f64>> = BTreeMap::new();
-            for (p, agent) in net.agents.iter().enumerate() {
-                let m = &agent.model;
-                let (pos, vel) = (2 * p, 2 * p + 1);
-                // The observer has no inertia (eq. 16b); the bodies do.
-                let scale = if part == Part::Observerless {
-                    if split {
-                        Matrix3::from_diagonal(&m.inertia.j.diagonal().map(|j| 1.0 / j))
-                    } else {
-                        m.inertia.j_inv
-                    }
-                } else {
-                    Matrix3::identity()
-                };
-                let mut stiff = m.leader_gain.as_ref().map_or(Matrix3::zeros(), psi_gain);
-                let mut damp = if m.leader_gain.is_some() && part == Part::Observer {
-                    1.0
-                } else {
-                    0.0
-                };
-                for nb in &m.neighbours {
-                    stiff += psi_gain(&nb.a);
-                    if part == Part::Observer {
-                        damp += 1.0;
-                    }
-                    let q = index[&nb.id];
-                    let steps = nb.link.map_or(0, |l| l.delay);
-                    let c = links
-                        .entry(steps)
-                        .or_insert_with(|| DMatrix::zeros(states, states));
-                    add(c, b, vel, 2 * q, &proj(&(scale * psi_gain(&nb.a) * k_r)));
-                    if part == Part::Observer {
-                        add(c, b, vel, 2 * q + 1, &(&eye * k_w));
-                    }
-                }
-                add(&mut a0, b, pos, vel, &eye);
-                add(&mut a0, b, vel, pos, &proj(&(scale * stiff * -k_r)));
-                let damping = if part == Part::Observerless {
-                    proj(&(scale * -k_w))
-                } else {
-                    &eye * (-k_w * damp)
-                };
-                add(&mut a0, b, vel, vel, &damping);
+            if !split || net.agents.len() > TREE_LIMIT {
+                return Err(too_large);
             }
-            let coupling = links
-                .values()
-                .fold(DMatrix::zeros(states, states), |acc, a| acc + a);
-            let common = Dde::new(a0.clone(), vec![(1.0, coupling.clone())]);
-            let size = roots::size(&common, MIN_ORDER + MIN_ORDER / 2);
-            if size > DENSE_LIMIT {
-                return Err(LinearError::TooLarge {
-                    states: size,
-                    limit: DENSE_LIMIT,
-                });
-            }
-            let profile = Profile::of(&a0, &coupling);
-            blocks.push(Block {
-                axis,
-                a0,
-                links,
-                profile,
-            });
-        }
-        let mut tracking = Vec::new();
-        if part == Part::Observer {
-            for agent in &net.agents {
-                let m = &agent.model;
-                let (kr, kw) = match m.scheme {
-                    Scheme::ObserverConstant { control, .. }
-                    | Scheme::ObserverTimeVarying { control, .. } => (control.k_r, control.k_w),
-                    Scheme::Observerless { control } => (control.k_r, control.k_w),
-                };
-                let e = psi_gain(&m.a_bar);
-                if split {
-                    for k in 0..3 {
-                        let j = m.inertia.j[(k, k)];
-                        for z in quadratic_roots(kw / j, kr * e[(k, k)] / j) {
-                            if z.im >= 0.0 {
-                                tracking.push((z, m.id, Some(k)));
-                            }
-                        }
-                    }
-                } else {
-                    let mut t = DMatrix::zeros(6, 6);
-                    t.view_mut((0, 3), (3, 3)).fill_with_identity();
-                    let jinv = m.inertia.j_inv;
-                    t.view_mut((3, 0), (3, 3))
-                        .copy_from_slice((jinv * e * -kr).as_slice());
-                    t.view_mut((3, 3), (3, 3))
-                        .copy_from_slice((jinv * -kw).as_slice());
-                    for z in roots::eigenvalues(&t) {
-                        if z.im >= 0.0 {
-                            tracking.push((z, m.id, None));
-                        }
-                    }
-                }
-            }
-        }
+            blocks::trees(net, part == Part::Observer, gains).map_err(|_| too_large)?
+        };
         Ok(Self {
             part,
-            agents: n_agents,
+            agents: net.agents.len(),
             dt: net.dt,
             blocks,
-            tracking,
+            tracking: blocks::tracking(net, part == Part::Observer, split),
         })
     }
 
-    /// The rightmost of the blocks' roots (each from `dde_of`) and the
+    /// The rightmost root of one block at `which` delays.
+    fn block_rightmost(&self, blk: &Block, which: Delays) -> Rightmost {
+        let (root, order, converged) = match &blk.body {
+            Body::Dense(b) => {
+                let dde = blk.dde(self.dt, which);
+                let f = roots::rightmost_with(&dde, &b.profile, DENSE_LIMIT);
+                (f.root, f.order, f.converged)
+            }
+            Body::Tree(t) => {
+                let taus = t.taus(self.dt, which);
+                match Search::new(&t.tree, taus).rightmost() {
+                    Some(z) => (z, 0, true),
+                    None => (Complex::new(f64::NAN, f64::NAN), 0, false),
+                }
+            }
+        };
+        Rightmost {
+            root: Root::from(root),
+            part: self.part,
+            axis: blk.axis,
+            order,
+            converged,
+        }
+    }
+
+    /// The rightmost of the blocks' roots at `which` delays and the
     /// tracking roots.
-    fn rightmost_with(&self, dde_of: impl Fn(&Block) -> Dde) -> Rightmost {
+    fn rightmost_with(&self, which: Delays) -> Rightmost {
         let mut best: Option<Rightmost> = None;
         let mut consider = |r: Rightmost| {
             if best.is_none_or(|b| r.root.re > b.root.re) {
@@ -327,14 +211,7 @@ impl Linearisation {
             }
         };
         for blk in &self.blocks {
-            let f = roots::rightmost_with(&dde_of(blk), &blk.profile, DENSE_LIMIT);
-            consider(Rightmost {
-                root: Root::from(f.root),
-                part: self.part,
-                axis: blk.axis,
-                order: f.order,
-                converged: f.converged,
-            });
+            consider(self.block_rightmost(blk, which));
         }
         for &(z, agent, axis) in &self.tracking {
             consider(Rightmost {
@@ -361,7 +238,7 @@ impl Linearisation {
     /// delays, and where it came from.
     #[must_use]
     pub fn rightmost_detail(&self) -> Rightmost {
-        self.rightmost_with(|b| b.own(self.dt))
+        self.rightmost_with(Delays::Own)
     }
 
     /// The rightmost root of the closed loop with every follower link
@@ -373,7 +250,7 @@ impl Linearisation {
             d.is_finite() && d >= 0.0,
             "delay {d} must be finite and ≥ 0"
         );
-        self.rightmost_with(|b| b.common(d))
+        self.rightmost_with(Delays::Common(d))
     }
 
     /// The rightmost root (largest real part; `Im ≥ 0`) at the network's own
@@ -391,13 +268,18 @@ impl Linearisation {
 
     /// The delay margin: the smallest common delay of every follower link at
     /// which a root reaches the imaginary axis ([`margin::common_delay`] on
-    /// each decoupled system; scheme 2's tracking loops are delay-free).
+    /// each dense decoupled system, [`tree_margin::margin`] on each tree;
+    /// scheme 2's tracking loops are delay-free).
     #[must_use]
     pub fn margin(&self) -> Margin {
         let tracking_unstable = self.tracking.iter().any(|(z, _, _)| z.re >= 0.0);
         let mut best: Option<Margin> = None;
         for blk in &self.blocks {
-            match margin::common_delay_with(&blk.a0, &blk.coupling(), &blk.profile) {
+            let m = match &blk.body {
+                Body::Dense(b) => margin::common_delay_with(&b.a0, &b.coupling(), &b.profile),
+                Body::Tree(t) => tree_margin::margin(&t.tree, || self.rightmost_at(0.0)),
+            };
+            match m {
                 Margin::UnstableWithoutDelay { .. } => {
                     return Margin::UnstableWithoutDelay {
                         rightmost: self.rightmost_at(0.0),
@@ -453,20 +335,26 @@ impl Linearisation {
     pub fn delays(&self) -> Vec<f64> {
         self.blocks
             .first()
-            .map(|b| b.links.keys().map(|&k| k as f64 * self.dt).collect())
+            .map(|b| b.steps().iter().map(|&k| k as f64 * self.dt).collect())
             .unwrap_or_default()
     }
 
     /// The delay systems at the network's own delays (one per axis, or one).
     #[must_use]
     pub fn systems(&self) -> Vec<Dde> {
-        self.blocks.iter().map(|b| b.own(self.dt)).collect()
+        self.blocks
+            .iter()
+            .map(|b| b.dde(self.dt, Delays::Own))
+            .collect()
     }
 
     /// The delay systems with every follower link delayed by `d` seconds.
     #[must_use]
     pub fn systems_at(&self, d: f64) -> Vec<Dde> {
-        self.blocks.iter().map(|b| b.common(d)).collect()
+        self.blocks
+            .iter()
+            .map(|b| b.dde(self.dt, Delays::Common(d)))
+            .collect()
     }
 
     /// [`Self::of`] without the split into axes (the same roots; a check).
@@ -474,6 +362,39 @@ impl Linearisation {
     pub(crate) fn of_full(net: &Network) -> Result<Self, LinearError> {
         let me = Self::of(net)?;
         Self::build(net, me.part, me.loop_gains(net), false)
+    }
+
+    /// [`Self::of`] on the tree path whatever the size (a check against
+    /// the dense path).
+    #[cfg(test)]
+    pub(crate) fn of_tree(net: &Network) -> Result<Self, LinearError> {
+        let me = Self::of(net)?;
+        let observer = me.part == Part::Observer;
+        let blocks = blocks::trees(net, observer, me.loop_gains(net)).map_err(|_| {
+            LinearError::TooLarge {
+                states: 0,
+                limit: 0,
+            }
+        })?;
+        Ok(Self { blocks, ..me })
+    }
+
+    /// The trees of the tree path's blocks.
+    #[cfg(test)]
+    pub(crate) fn trees(&self) -> Vec<super::tree::Tree> {
+        self.blocks
+            .iter()
+            .filter_map(|b| match &b.body {
+                Body::Tree(t) => Some(t.tree.clone()),
+                Body::Dense(_) => None,
+            })
+            .collect()
+    }
+
+    /// Whether every decoupled system is on the tree path.
+    #[cfg(test)]
+    pub(crate) fn on_trees(&self) -> bool {
+        self.blocks.iter().all(|b| matches!(b.body, Body::Tree(_)))
     }
 
     #[cfg(test)]

@@ -14,13 +14,13 @@ use crate::reference::LeaderState;
 use crate::so3::{exp, rot};
 use nalgebra::{Complex, DMatrix, Matrix3, Vector3};
 
-const DT: f64 = 0.001;
+pub(super) const DT: f64 = 0.001;
 
 fn c(re: f64, im: f64) -> Complex<f64> {
     Complex::new(re, im)
 }
 
-fn diag(a: f64, b: f64, c: f64) -> Matrix3<f64> {
+pub(super) fn diag(a: f64, b: f64, c: f64) -> Matrix3<f64> {
     Matrix3::from_diagonal(&Vector3::new(a, b, c))
 }
 
@@ -128,7 +128,7 @@ fn the_pure_delay_margin_is_pi_over_2a_and_is_where_the_root_crosses() {
 
 // ------------------------------------------------------------- networks
 
-fn delay(steps: u64) -> Option<LinkModel> {
+pub(super) fn delay(steps: u64) -> Option<LinkModel> {
     Some(LinkModel {
         delay: steps,
         jitter: 0,
@@ -139,7 +139,7 @@ fn delay(steps: u64) -> Option<LinkModel> {
 }
 
 /// One agent: id, inertia, a_bar, neighbours, leader gain.
-fn agent(
+pub(super) fn agent(
     id: u32,
     j: Matrix3<f64>,
     scheme: Scheme,
@@ -171,13 +171,13 @@ fn agent(
 
 use crate::network::Scheme;
 
-fn observerless(k_r: f64, k_w: f64) -> Scheme {
+pub(super) fn observerless(k_r: f64, k_w: f64) -> Scheme {
     Scheme::Observerless {
         control: ControlGains { k_r, k_w },
     }
 }
 
-fn observer(k_r: f64, k_w: f64, kc_r: f64, kc_w: f64) -> Scheme {
+pub(super) fn observer(k_r: f64, k_w: f64, kc_r: f64, kc_w: f64) -> Scheme {
     Scheme::ObserverConstant {
         observer: ObserverGains {
             k_r,
@@ -192,12 +192,12 @@ fn observer(k_r: f64, k_w: f64, kc_r: f64, kc_w: f64) -> Scheme {
 }
 
 /// Per-link delays in steps: 2→1, 1→2, 3→2, 2→3.
-type Delays = [u64; 4];
+pub(super) type Delays = [u64; 4];
 
 /// A path 1 — 2 — 3, the leader on 1; the paper's inertias and gains
 /// (`Jᵢ = diag(i, i+2, 2i)/10`, `Ǎ_{i,j} = diag(10−m, 9−m, 8−m)`); `rotate`
 /// turns every inertia and gain by a fixed rotation (no longer diagonal).
-fn path3(scheme: Scheme, d: Delays, rotate: bool) -> Network {
+pub(super) fn path3(scheme: Scheme, d: Delays, rotate: bool) -> Network {
     let q = if rotate {
         rot(0.7, &Vector3::new(1.0, -2.0, 0.5).normalize())
     } else {
@@ -249,7 +249,7 @@ fn path3(scheme: Scheme, d: Delays, rotate: bool) -> Network {
 
 /// The paper's 7-agent graph (edges 1–3, 2–7, 3–5, 3–6, 4–5, leader on 1
 /// and 2), every follower link delayed by `steps`.
-fn paper7(scheme: Scheme, steps: u64) -> Network {
+pub(super) fn paper7(scheme: Scheme, steps: u64) -> Network {
     let edges = [(1u32, 3u32), (2, 7), (3, 5), (3, 6), (4, 5)];
     let mut agents: Vec<AgentSpec> = (1..=7u32)
         .map(|id| {
@@ -701,21 +701,44 @@ fn refusals() {
     assert!(Linearisation::of(&net).is_ok());
 
     // Too many agents for dense matrices: a chain of 40 agents is per axis
-    // n = 80 with p = 40 delayed, 80 + 40·18 = 800 fits; 60: 120 + 1080.
-    assert!(Linearisation::of(&chain(40, observerless(1.9, 1.9), 3)).is_ok());
-    let e = Linearisation::of(&chain(60, observerless(1.9, 1.9), 3)).expect_err("too large");
-    assert_eq!(
-        e,
+    // n = 80 with p = 40 delayed, 80 + 40·18 = 800 fits; 60: 120 + 1080
+    // goes to the tree path; closed into a ring (not a forest), or with
+    // gains that are not diagonal (no split into axes), it is refused.
+    let small = Linearisation::of(&chain(40, observerless(1.9, 1.9), 3)).expect("dense");
+    assert!(!small.on_trees());
+    let large = Linearisation::of(&chain(60, observerless(1.9, 1.9), 3)).expect("tree");
+    assert!(large.on_trees() && large.per_axis());
+    let mut ring = chain(60, observerless(1.9, 1.9), 3);
+    let g = ring.agents[0].model.neighbours[0].a;
+    let link = ring.agents[0].model.neighbours[0].link;
+    ring.agents[0]
+        .model
+        .neighbours
+        .push(Neighbour { id: 60, a: g, link });
+    ring.agents[59]
+        .model
+        .neighbours
+        .push(Neighbour { id: 1, a: g, link });
+    let too_large = LinearError::TooLarge {
+        states: 1200,
+        limit: model::DENSE_LIMIT,
+    };
+    assert_eq!(Linearisation::of(&ring).expect_err("ring"), too_large);
+    let mut turned = chain(60, observerless(1.9, 1.9), 3);
+    let q = rot(0.4, &Vector3::new(0.3, 1.0, -1.0).normalize());
+    turned.agents[5].model.inertia =
+        Inertia::new(q * turned.agents[5].model.inertia.j * q.transpose());
+    assert_eq!(Linearisation::of(&turned).expect_err("not split"), {
         LinearError::TooLarge {
-            states: 1200,
-            limit: model::DENSE_LIMIT
+            states: 360 + 180 * 18,
+            limit: model::DENSE_LIMIT,
         }
-    );
+    });
 }
 
 /// A chain 1 — 2 — … — n, the leader on 1, every follower link delayed by
 /// `steps`, the paper's inertias.
-fn chain(n: u32, scheme: Scheme, steps: u64) -> Network {
+pub(super) fn chain(n: u32, scheme: Scheme, steps: u64) -> Network {
     let mut net = paper7(scheme, steps);
     net.agents = (1..=n)
         .map(|id| {

@@ -126,8 +126,9 @@ pub fn run_in_process(p: &Prepared, judging: &Judging, interrupt: &Interrupt) ->
 }
 
 /// Runs trial `p` as processes (its own iceoryx2 namespace; node logs in
-/// `logs`), keeping only its trace; with `--until settled` it runs again
-/// from t = 0 with a longer horizon until the verdict is final.
+/// `logs`), keeping only its trace; with `--until settled` to the horizon
+/// the in-process engine finds ([`until::settled_horizon`]), or, with
+/// plug-ins, again from t = 0 with a longer horizon until the verdict is final.
 ///
 /// # Errors
 /// The process engine could not start.
@@ -143,6 +144,12 @@ pub fn run_processes(
     let mut trace = Trace::new(net.dt, has_observer(p));
     let mut opts = opts.clone();
     opts.plugins = p.loaded.resolved.plugins.clone();
+    // Without plug-ins the in-process engine finds the final horizon
+    // (bit-identical lockstep): the processes run once, to it.
+    let probe = matches!(judging.until, until::Until::Settled { .. }) && opts.plugins.is_empty();
+    if probe && let Some((horizon, _)) = until::settled_horizon(&net, judging, interrupt) {
+        net.steps = horizon;
+    }
     loop {
         trace.clear();
         let outcome = processes::run(&net, &opts, logs, interrupt.flag(), |snap| {

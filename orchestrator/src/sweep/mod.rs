@@ -5,8 +5,8 @@
 //! Each run is judged by its verdict (`docs/verdicts.md`, `attsync_verdict`):
 //! read from the largest attitude error over agents over the whole run, not
 //! from its last sample; `converged` still means below `--tolerance`.
-//! `--find-margin` bisects on whether the error decays (`converged` or
-//! `converging`; an `undecided` run by the sign of its decay rate), with
+//! `--find-margin` bisects on whether the runs show the error decaying
+//! (`converged` or `converging`), with
 //! every run extended until its verdict is final (`--until settled`), and
 //! puts the linearisation's exact margin (`attsync margin`,
 //! `attitude::linear`) beside the bracket it finds ([`margin`]).
@@ -260,16 +260,15 @@ pub struct SweepRow {
 }
 
 impl SweepRow {
-    /// Whether the run's error decays: `converged` or `converging`;
-    /// `undecided` by the sign of its decay rate; `persistent`,
-    /// `diverging` and a failed run do not.
+    /// Whether the run showed its error decaying: `converged` or
+    /// `converging`. `persistent`, `diverging`, a failed run — and a run
+    /// still `undecided` at `--max-duration`, whose decay its window could
+    /// not establish — do not: the bracket is conservative (near the
+    /// margin a growing mode and a dying transient can leave a flat
+    /// envelope whose fitted rate has either sign).
     #[must_use]
     pub fn decays(&self) -> bool {
-        match self.verdict.kind {
-            Kind::Converged | Kind::Converging => self.complete,
-            Kind::Persistent | Kind::Diverging => false,
-            Kind::Undecided => self.complete && self.verdict.decay_rate.is_some_and(|r| r < 0.0),
-        }
+        self.complete && matches!(self.verdict.kind, Kind::Converged | Kind::Converging)
     }
 }
 
