@@ -172,22 +172,7 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     let started = Instant::now();
     let driven = drive(loaded, opts, &layout, interrupt)?;
     let wall_seconds = started.elapsed().as_secs_f64();
-    let text = match &driven.judged.until {
-        // The results are those of the scenario run to the final horizon:
-        // say so in its scenario.toml (what `verify` re-runs).
-        Some(u) if driven.judged.horizon != loaded.resolved.network.steps => {
-            let t = crate::results::fmt_time(driven.judged.horizon, loaded.resolved.network.dt);
-            let text = loaded.document.with_set(format!("simulation.duration={t}"));
-            let text = toml::to_string(&text).expect("a TOML table serialises");
-            std::fs::write(layout.scenario(), &text).map_err(io_at(&layout.scenario()))?;
-            tracing::debug!(
-                duration = u.duration,
-                "run: scenario.toml at the final horizon"
-            );
-            text
-        }
-        _ => text,
-    };
+    let text = final_scenario(loaded, &layout, &driven.judged)?.unwrap_or(text);
     let Driven {
         outcome,
         series,
@@ -206,6 +191,26 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
     staging.commit().map_err(io_at(&opts.out))?;
     tracing::debug!(out = %opts.out.display(), complete = summary.complete, "run: committed");
     Ok(summary)
+}
+
+/// The results of a run `--until settled` extended are those of its
+/// scenario run to the final horizon: `scenario.toml` (what `verify`
+/// re-runs) says so. Its new text, if it changed.
+fn final_scenario(
+    loaded: &Loaded,
+    layout: &RunLayout,
+    judged: &Judged,
+) -> Result<Option<String>, RunError> {
+    let net = &loaded.resolved.network;
+    if judged.until.is_none() || judged.horizon == net.steps {
+        return Ok(None);
+    }
+    let t = crate::results::fmt_time(judged.horizon, net.dt);
+    let document = loaded.document.with_set(format!("simulation.duration={t}"));
+    let text = toml::to_string(&document).expect("a TOML table serialises");
+    std::fs::write(layout.scenario(), &text).map_err(io_at(&layout.scenario()))?;
+    tracing::debug!(duration = %t, "run: scenario.toml at the final horizon");
+    Ok(Some(text))
 }
 
 /// What [`drive`] recorded: how the run ended, the series, the in-process

@@ -5,10 +5,12 @@
 //! Along every side the change of `arg f` is summed over segments refined
 //! adaptively until each is resolved: with `m` its midpoint, the principal
 //! values of `Im(ln f(m) − ln f(a))` and `Im(ln f(b) − ln f(m))` are each at
-//! most [`MAX_TURN`] and Simpson's rule on `(ln f)'` reproduces both the
-//! exact `Re(ln f(b) − ln f(a))` and their sum within [`AGREE`]. A zero close
-//! to a segment turns the argument by ≈ π there, or makes `(ln f)'` too
-//! sharp for Simpson's rule: the segment is split. The resolved turns are
+//! most [`MAX_TURN`], Simpson's rule on `(ln f)'` reproduces both the
+//! exact `Re(ln f(b) − ln f(a))` and their sum within [`AGREE`], and the
+//! segment is short against `1/|(ln f)'|` at its three points
+//! ([`MAX_PULL`]). A zero close to a segment turns the argument by ≈ π
+//! there, makes `(ln f)'` too sharp for Simpson's rule, or large at the
+//! nearest point: the segment is split. The resolved turns are
 //! principal values of differences of `Im ln f`, so around a closed contour
 //! they add up to `2π k` exactly (up to rounding). (After the standard
 //! practice of Kravanja & Van Barel, "Computing the zeros of analytic
@@ -25,11 +27,17 @@ use std::f64::consts::PI;
 type C = Complex<f64>;
 
 /// The largest turn of `arg f` accepted over half a segment, rad.
-pub const MAX_TURN: f64 = 1.0;
+pub const MAX_TURN: f64 = 1.5;
 
 /// Agreement of Simpson's rule with the exact change of `ln f` over a
 /// segment (both parts), absolute.
-pub const AGREE: f64 = 0.05;
+pub const AGREE: f64 = 0.1;
+
+/// The largest `h·|(ln f)'|` accepted at a segment's three points (`h` its
+/// length): a cluster of `k` zeros within the segment is within `h/4` of
+/// one of them, where `|(ln f)'| ≈ 4k/h`; a miscount needs two zeros
+/// (one only turns `arg f` by ≈ π, which [`MAX_TURN`] catches), `8/h`.
+pub const MAX_PULL: f64 = 6.0;
 
 /// Evaluations of `f` per contour before giving up.
 pub const MAX_EVALS: usize = 400_000;
@@ -53,6 +61,9 @@ pub struct Turn {
     pub turn: f64,
     /// The segment's length.
     pub span: f64,
+    /// `|(ln f)'|` at the midpoint: about the inverse distance to the
+    /// nearest zero, inside or outside.
+    pub pull: f64,
 }
 
 /// The total turn of `arg f` along a polyline and where it turned.
@@ -60,7 +71,8 @@ pub struct Turn {
 pub struct Walk {
     /// The total turn, rad.
     pub turn: f64,
-    /// Every resolved segment with a turn of at least 0.05 rad.
+    /// Every resolved segment where `arg f` turned by at least 0.05 rad or
+    /// `ln |f|` changed by about as much.
     pub turns: Vec<Turn>,
     /// Evaluations of `f`.
     pub evals: usize,
@@ -86,17 +98,25 @@ fn segment(f: &impl Fn(C) -> Option<LogDet>, a: Point, b: Point, walk: &mut Walk
         let t2 = wrap(b.1.value.im - fm.1.value.im);
         let exact_re = b.1.value.re - a.1.value.re;
         let q = h / 6.0 * (a.1.slope + fm.1.slope * 4.0 + b.1.slope);
-        let resolved = t1.abs() <= MAX_TURN
+        let pull =
+            a.1.slope
+                .norm()
+                .max(fm.1.slope.norm())
+                .max(b.1.slope.norm());
+        let resolved = pull * h.norm() <= MAX_PULL
+            && t1.abs() <= MAX_TURN
             && t2.abs() <= MAX_TURN
             && (q.re - exact_re).abs() <= AGREE
             && (q.im - (t1 + t2)).abs() <= AGREE;
         if resolved {
             walk.turn += t1 + t2;
-            if (t1 + t2).abs() >= 0.05 {
+            let pull = fm.1.slope.norm();
+            if (t1 + t2).abs() >= 0.05 || pull * h.norm() >= 0.05 {
                 walk.turns.push(Turn {
                     at: m,
                     turn: t1 + t2,
                     span: h.norm(),
+                    pull,
                 });
             }
         } else {
@@ -109,16 +129,13 @@ fn segment(f: &impl Fn(C) -> Option<LogDet>, a: Point, b: Point, walk: &mut Walk
 }
 
 /// The turn of `arg f` along the polyline through `vertices`.
-pub static CONTOURS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub static EVALS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 pub fn walk(f: &impl Fn(C) -> Option<LogDet>, vertices: &[C]) -> Option<Walk> {
     let mut w = Walk::default();
-    let r = walk_(f, vertices, &mut w);
-    CONTOURS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    EVALS.fetch_add(w.evals, std::sync::atomic::Ordering::Relaxed);
-    r.map(|_| w)
+    walk_into(f, vertices, &mut w).map(|()| w)
 }
-fn walk_(f: &impl Fn(C) -> Option<LogDet>, vertices: &[C], w: &mut Walk) -> Option<()> {
+
+/// [`walk`] into `w`.
+fn walk_into(f: &impl Fn(C) -> Option<LogDet>, vertices: &[C], w: &mut Walk) -> Option<()> {
     let mut prev: Option<Point> = None;
     for pair in vertices.windows(2) {
         let (a, b) = (pair[0], pair[1]);

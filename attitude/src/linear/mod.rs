@@ -21,7 +21,20 @@
 //! Refused ([`LinearError`]): scheme 1 (time-varying error dynamics),
 //! sampled coupling (a hold, not a delay), a follower link with jitter, loss
 //! or a period; networks whose decoupled system is too large for dense
-//! matrices.
+//! matrices and that cannot take the tree path.
+//!
+//! # Large networks: the tree path
+//! Where the dense discretisation would exceed [`model::DENSE_LIMIT`], a
+//! network that splits per axis (diagonal inertias and gains) and whose
+//! graph is a forest (Assumption 1) is analysed without any matrix of size
+//! beyond `N`: per axis, `Δ(s)` is tree-structured ([`tree`]), so
+//! `ln det Δ(s)` and its derivatives cost `O(N)` (leaves-first elimination,
+//! no fill-in). The rightmost root is bracketed by counting roots right of
+//! `Re s = σ` with the argument principle ([`contour`]) and found by Newton
+//! on `ln det Δ` ([`tree_roots`]); the margin is where that count at
+//! `σ = 0` first leaves 0 as the common delay grows, the crossing then
+//! solved for `(ω, d)` by Newton ([`tree_margin`]). Up to
+//! [`model::TREE_LIMIT`] agents; otherwise [`LinearError::TooLarge`].
 //!
 //! # Layout
 //! - [`model`]: [`Linearisation`] from a [`crate::network::Network`].
@@ -32,6 +45,10 @@
 //! - [`cheb`]: Chebyshev nodes, differentiation, barycentric interpolation.
 //! - [`eig`]: dense eigenvalues (real and complex QR with an iteration limit).
 //! - [`error`]: why a network is refused.
+//! - [`tree`]: one axis's `Δ(s)` on a forest, `ln det Δ` in `O(N)`.
+//! - [`contour`]: counting zeros in a box by the argument principle.
+//! - [`tree_roots`]: the rightmost root on the tree path.
+//! - [`tree_margin`]: the delay margin on the tree path.
 
 mod blocks;
 pub mod cheb;

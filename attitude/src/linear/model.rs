@@ -176,8 +176,9 @@ impl Linearisation {
         })
     }
 
-    /// The rightmost root of one block at `which` delays.
-    fn block_rightmost(&self, blk: &Block, which: Delays) -> Rightmost {
+    /// The rightmost root of one block at `which` delays; `None` for a
+    /// tree with no root right of `floor` (the rightmost found so far).
+    fn block_rightmost(&self, blk: &Block, which: Delays, floor: Option<f64>) -> Option<Rightmost> {
         let (root, order, converged) = match &blk.body {
             Body::Dense(b) => {
                 let dde = blk.dde(self.dt, which);
@@ -185,53 +186,68 @@ impl Linearisation {
                 (f.root, f.order, f.converged)
             }
             Body::Tree(t) => {
-                let taus = t.taus(self.dt, which);
-                match Search::new(&t.tree, taus).rightmost() {
+                let search = Search::new(&t.tree, t.taus(self.dt, which));
+                if let Some(x) = floor {
+                    if search.right_of(x).is_some_and(|r| r.count == 0) {
+                        return None;
+                    }
+                }
+                match search.rightmost() {
                     Some(z) => (z, 0, true),
                     None => (Complex::new(f64::NAN, f64::NAN), 0, false),
                 }
             }
         };
-        Rightmost {
+        Some(Rightmost {
             root: Root::from(root),
             part: self.part,
             axis: blk.axis,
             order,
             converged,
-        }
+        })
     }
 
     /// The rightmost of the blocks' roots at `which` delays and the
-    /// tracking roots.
+    /// tracking roots (not `converged` if a tree's search failed: its
+    /// roots are unknown).
     fn rightmost_with(&self, which: Delays) -> Rightmost {
+        let tracking = self.tracking.iter().map(|&(z, agent, axis)| Rightmost {
+            root: Root::from(z),
+            part: Part::Tracking { agent },
+            axis,
+            order: 0,
+            converged: true,
+        });
+        let mut floor = tracking.clone().map(|r| r.root.re).reduce(f64::max);
         let mut best: Option<Rightmost> = None;
+        let mut failed = false;
         let mut consider = |r: Rightmost| {
             if best.is_none_or(|b| r.root.re > b.root.re) {
                 best = Some(r);
             }
         };
         for blk in &self.blocks {
-            consider(self.block_rightmost(blk, which));
+            if let Some(r) = self.block_rightmost(blk, which, floor) {
+                failed |= r.root.re.is_nan();
+                if !r.root.re.is_nan() {
+                    floor = Some(floor.map_or(r.root.re, |f| f.max(r.root.re)));
+                    consider(r);
+                }
+            }
         }
-        for &(z, agent, axis) in &self.tracking {
-            consider(Rightmost {
-                root: Root::from(z),
-                part: Part::Tracking { agent },
-                axis,
-                order: 0,
-                converged: true,
-            });
-        }
-        best.unwrap_or(Rightmost {
+        tracking.for_each(&mut consider);
+        let mut out = best.unwrap_or(Rightmost {
             root: Root {
-                re: f64::NEG_INFINITY,
+                re: if failed { f64::NAN } else { f64::NEG_INFINITY },
                 im: 0.0,
             },
             part: self.part,
             axis: None,
             order: 0,
-            converged: true,
-        })
+            converged: !failed,
+        });
+        out.converged &= !failed;
+        out
     }
 
     /// The rightmost root of the closed loop at the network's own per-link
@@ -277,7 +293,13 @@ impl Linearisation {
         for blk in &self.blocks {
             let m = match &blk.body {
                 Body::Dense(b) => margin::common_delay_with(&b.a0, &b.coupling(), &b.profile),
-                Body::Tree(t) => tree_margin::margin(&t.tree, || self.rightmost_at(0.0)),
+                Body::Tree(t) => {
+                    let cap = match best {
+                        Some(Margin::Crossing { delay, .. }) => Some(delay),
+                        _ => None,
+                    };
+                    tree_margin::margin(&t.tree, || self.rightmost_at(0.0), cap)
+                }
             };
             match m {
                 Margin::UnstableWithoutDelay { .. } => {

@@ -18,12 +18,13 @@
 //!    such frequency `ω_lo` bounds the first crossing: every crossing
 //!    frequency `ω ≥ ω_lo` has a crossing delay `d ≤ 2π/ω ≤ 2π/ω_lo`;
 //! 3. `d` doubles from `2π/(64 ρ)` until `n₀(d) > 0` (past `2π/ω_lo`: delay
-//!    independent), then bisects to 10⁻³ relative;
-//! 4. the roots right of the axis at the upper end (close to it) are found
-//!    ([`Search::roots_right_of`]) and each continued by Newton's method on
+//!    independent), then bisects to 2 % relative and until one pair is
+//!    right of the axis;
+//! 4. that pair, the rightmost root at the upper end
+//!    ([`Search::rightmost`]), is continued by Newton's method on
 //!    `det Δ(iω; d) = 0` in the two real unknowns `(ω, d)`
-//!    ([`Tree::eval_delay`] gives `∂/∂d ln det Δ`); the smallest `d` is the
-//!    margin, confirmed as [`super::margin`] does (Newton on `s` from `iω`).
+//!    ([`Tree::eval_delay`] gives `∂/∂d ln det Δ`) to the crossing, and
+//!    confirmed as [`super::margin`] does (Newton on `s` from `iω`).
 //!
 //! # Limits
 //! A window of instability that opens and closes again between two
@@ -46,7 +47,7 @@ const PER_DECADE: usize = 200;
 const DECADES: usize = 6;
 
 /// Relative width of the delay bracket before Newton's method.
-const BRACKET: f64 = 1e-3;
+const BRACKET: f64 = 0.02;
 
 /// Newton iterations on `(ω, d)`.
 const NEWTON_MAX: usize = 50;
@@ -78,10 +79,10 @@ fn lowest_crossing_frequency(tree: &Tree, top: f64) -> Option<f64> {
     None
 }
 
-/// Whether a root is right of the axis at common delay `d` (`None`: no
+/// How many roots are right of the axis at common delay `d` (`None`: no
 /// contour resolved).
-fn unstable(tree: &Tree, d: f64) -> Option<bool> {
-    common(tree, d).right_of(0.0).map(|r| r.count > 0)
+fn unstable(tree: &Tree, d: f64) -> Option<usize> {
+    common(tree, d).right_of(0.0).map(|r| r.count)
 }
 
 /// Newton's method on `det Δ(iω; d) = 0` in `(ω, d)` from `(w, d)`:
@@ -118,9 +119,11 @@ fn crossing(tree: &Tree, mut w: f64, mut d: f64) -> Option<(f64, f64)> {
 
 /// The delay margin of `tree` over a common delay on every entry (the
 /// module's docs); `rightmost_free` gives the rightmost root at `d = 0` for
-/// [`Margin::UnstableWithoutDelay`].
+/// [`Margin::UnstableWithoutDelay`]. Crossings beyond `cap` (a margin
+/// already found elsewhere) are not sought: if none is below it,
+/// [`Margin::DelayIndependent`].
 #[must_use]
-pub fn margin(tree: &Tree, rightmost_free: impl Fn() -> Root) -> Margin {
+pub fn margin(tree: &Tree, rightmost_free: impl Fn() -> Root, cap: Option<f64>) -> Margin {
     let free = common(tree, 0.0);
     let scale = free.scale();
     if free.right_of(-1e-10 * scale).is_none_or(|r| r.count > 0) {
@@ -135,40 +138,64 @@ pub fn margin(tree: &Tree, rightmost_free: impl Fn() -> Root) -> Margin {
         return Margin::DelayIndependent;
     };
     let d_max = 2.0 * PI / w_lo.max(1e-300);
-    let (mut d_lo, mut d_hi) = (0.0, 2.0 * PI / (64.0 * scale));
-    loop {
-        match unstable(tree, d_hi) {
-            Some(true) => break,
-            Some(false) => {}
-            None => return Margin::DelayIndependent,
-        }
-        if d_hi > d_max {
-            return Margin::DelayIndependent;
-        }
-        (d_lo, d_hi) = (d_hi, 2.0 * d_hi);
+    match bracket(tree, 2.0 * PI / (64.0 * scale), d_max, cap) {
+        Some((d_lo, d_hi)) => settle(tree, d_lo, d_hi),
+        None => Margin::DelayIndependent,
     }
-    while d_hi - d_lo > BRACKET * d_hi {
+}
+
+/// `d` doubling from `d0` until a root is right of the axis (at most up to
+/// `cap`, and past `d_max`: `None`), then bisected: a stable and an
+/// unstable delay within [`BRACKET`].
+fn bracket(tree: &Tree, d0: f64, d_max: f64, cap: Option<f64>) -> Option<(f64, f64)> {
+    let cap = cap.unwrap_or(f64::INFINITY);
+    let (mut d_lo, mut d_hi) = (0.0, d0.min(cap));
+    let mut count = loop {
+        let n = unstable(tree, d_hi)?;
+        if n > 0 {
+            break n;
+        }
+        if d_hi >= cap || d_hi > d_max {
+            return None;
+        }
+        (d_lo, d_hi) = (d_hi, (2.0 * d_hi).min(cap));
+    };
+    // Until one pair (a real root cannot cross at ω > 0) is right of the axis.
+    while (d_hi - d_lo > BRACKET * d_hi || count > 2) && d_hi - d_lo > 1e-12 * d_hi {
         let mid = 0.5 * (d_lo + d_hi);
         match unstable(tree, mid) {
-            Some(true) => d_hi = mid,
+            Some(n) if n > 0 => (d_hi, count) = (mid, n),
             _ => d_lo = mid,
         }
     }
-    settle(tree, d_lo, d_hi)
+    Some((d_lo, d_hi))
 }
 
-/// The crossing between `d_lo` (stable) and `d_hi` (unstable).
-fn settle(tree: &Tree, d_lo: f64, d_hi: f64) -> Margin {
-    let roots = common(tree, d_hi).roots_right_of(0.0).unwrap_or_default();
-    let best = roots
-        .iter()
-        .filter_map(|z| crossing(tree, z.im.abs(), d_hi))
-        .filter(|&(_, d)| d >= d_lo * (1.0 - 1e-6) && d <= d_hi * (1.0 + 1e-6))
-        .min_by(|a, b| a.1.total_cmp(&b.1));
-    let (omega, delay) = best.unwrap_or_else(|| {
-        let w = roots.first().map_or(f64::NAN, |z| z.im.abs());
-        (w, d_hi)
-    });
+/// Bisections of the bracket at most while Newton's method on `(ω, d)`
+/// does not land in it.
+const SETTLE_MAX: usize = 40;
+
+/// The crossing between `d_lo` (stable) and `d_hi` (unstable): Newton's
+/// method on `(ω, d)` from the rightmost root at `d_hi`, the bracket
+/// bisected (the root nearer the axis) until it lands inside.
+fn settle(tree: &Tree, mut d_lo: f64, mut d_hi: f64) -> Margin {
+    let mut guess = (f64::NAN, d_hi);
+    for _ in 0..SETTLE_MAX {
+        if let Some(z) = common(tree, d_hi).rightmost() {
+            guess = (z.im.abs(), d_hi);
+            let inside = |d: f64| d >= d_lo * (1.0 - 1e-9) && d <= d_hi * (1.0 + 1e-9);
+            if let Some((w, d)) = crossing(tree, z.im.abs(), d_hi).filter(|c| inside(c.1)) {
+                guess = (w, d);
+                break;
+            }
+        }
+        let mid = 0.5 * (d_lo + d_hi);
+        match unstable(tree, mid) {
+            Some(n) if n > 0 => d_hi = mid,
+            _ => d_lo = mid,
+        }
+    }
+    let (omega, delay) = guess;
     let axis_distance = common(tree, delay)
         .newton(C::new(0.0, omega))
         .map_or(f64::INFINITY, |s| s.re.abs());

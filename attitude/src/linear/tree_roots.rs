@@ -6,13 +6,13 @@
 //! - **Box.** Every root with `Re s ≥ σ` has `|s| ≤ ρ(σ)` ([`Tree::radius`]),
 //!   so the roots right of `σ` are those in `[σ, R] × [−R, R]`, `R > ρ(σ)`:
 //!   `n(σ)` ([`Search::right_of`], one contour).
-//! - **Bracket.** `n(ρ(0)) = 0`; from `σ = 0`, then `σ = −10⁻⁶ρ·4ᵏ` down
-//!   until `n(σ) > 0`. Then `lo` (`n(lo) > 0`) and `hi` (`n(hi) = 0`) are
-//!   bisected.
+//! - **Bracket.** `n(ρ(0)) = 0`; from `σ = 0`, then `σ = ∓10⁻⁶ρ·4ᵏ` down
+//!   until `n(σ) > 0` (or up until `n(σ) = 0`). Then `lo` (`n(lo) > 0`)
+//!   and `hi` (`n(hi) = 0`) are bisected.
 //! - **Roots.** Once at most [`MAX_LOCAL`] roots are right of `lo`, the
 //!   contour's left side passes close to each: `arg det Δ` turns forwards
-//!   fast there ([`contour::Walk::turns`]), and Newton's method from those
-//!   points finds them. When the roots found with `Re s > lo` (a pair counting
+//!   fast there, or `|det Δ|` dips ([`contour::Walk::turns`]), and Newton's
+//!   method from those points finds them. When the roots found with `Re s > lo` (a pair counting
 //!   twice) are `n(lo)` in number, the rightmost of them is *the* rightmost
 //!   root: the count certifies that none was missed. Else the bisection
 //!   goes on (`lo` nearer the rightmost roots).
@@ -143,30 +143,47 @@ impl<'a> Search<'a> {
         (last <= 1e-6 * (1.0 + s.norm())).then_some(s)
     }
 
-    /// The roots right of `r.sigma` that Newton's method finds from where
-    /// the contour's left side turned, if they are all `r.count` of them.
-    fn localise(&self, r: &Right) -> Option<Vec<C>> {
+    /// Where Newton's method should start to find the roots right of
+    /// `r.sigma`: first where the contour's left side turned forwards
+    /// fastest (next to a root inside; one outside turns it backwards),
+    /// then, a root inside and one outside at one height cancelling in the
+    /// turn, where it passed nearest to any root, moved right by that
+    /// distance.
+    fn starts(&self, r: &Right) -> Vec<C> {
         let lo = r.sigma;
         let tol = 1e-12 * (lo.abs() + self.scale);
-        // Where the left side turned forwards fastest: next to a root
-        // inside (a root outside turns it backwards).
-        let mut starts: Vec<_> = r
+        let left: Vec<_> = r
             .walk
             .turns
             .iter()
-            .filter(|t| (t.at.re - lo).abs() <= tol && t.turn > 0.0)
+            .filter(|t| (t.at.re - lo).abs() <= tol)
             .collect();
-        starts.sort_by(|a, b| (b.turn / b.span).total_cmp(&(a.turn / a.span)));
+        let mut forward: Vec<_> = left.iter().filter(|t| t.turn > 0.0).collect();
+        forward.sort_by(|a, b| (b.turn / b.span).total_cmp(&(a.turn / a.span)));
+        let mut near = left.clone();
+        near.sort_by(|a, b| b.pull.total_cmp(&a.pull));
+        let k = 2 * r.count + 6;
+        forward
+            .iter()
+            .take(k)
+            .map(|t| t.at)
+            .chain(near.iter().take(k).map(|t| t.at + 1.0 / t.pull))
+            .collect()
+    }
+
+    /// The roots right of `r.sigma` that Newton's method finds from
+    /// [`Self::starts`], if they are all `r.count` of them.
+    fn localise(&self, r: &Right) -> Option<Vec<C>> {
         let mut roots: Vec<C> = Vec::new();
         let mut found = 0;
-        for t in starts.iter().take(3 * r.count + 6) {
-            let Some(z) = self.newton(t.at).map(canonical) else {
+        for s0 in self.starts(r) {
+            let Some(z) = self.newton(s0).map(canonical) else {
                 continue;
             };
             let new = !roots
                 .iter()
                 .any(|q| (q - z).norm() <= 1e-8 * (1.0 + z.norm()));
-            if new && z.re > lo {
+            if new && z.re > r.sigma {
                 roots.push(z);
                 found += if z.im > 0.0 { 2 } else { 1 };
                 if found >= r.count {
@@ -195,17 +212,38 @@ impl<'a> Search<'a> {
     /// contour resolves or no bracket is found within `10⁶ρ` of the axis.
     #[must_use]
     pub fn rightmost(&self) -> Option<C> {
-        let mut hi = self.tree.radius(0.0, &self.taus) * 1.01 + 1e-9 * self.scale;
-        let mut lo = self.right_of(0.0)?;
+        let radius = self.tree.radius(0.0, &self.taus) * 1.01 + 1e-9 * self.scale;
+        let first = self.right_of(0.0)?;
         let mut step = 1e-6 * self.scale;
-        while lo.count == 0 {
-            hi = lo.sigma;
-            if step > 1e6 * self.scale {
-                return None;
+        let (mut lo, mut hi) = if first.count == 0 {
+            // Down from the axis until a root is right of σ.
+            let mut hi = first.sigma;
+            loop {
+                if step > 1e6 * self.scale {
+                    return None;
+                }
+                let r = self.right_of(-step)?;
+                step *= 4.0;
+                if r.count > 0 {
+                    break (r, hi);
+                }
+                hi = r.sigma;
             }
-            lo = self.right_of(-step)?;
-            step *= 4.0;
-        }
+        } else {
+            // Up from the axis until none is.
+            let mut lo = first;
+            loop {
+                if step >= radius {
+                    break (lo, radius);
+                }
+                let r = self.right_of(step)?;
+                if r.count == 0 {
+                    break (lo, r.sigma);
+                }
+                lo = r;
+                step *= 4.0;
+            }
+        };
         for _ in 0..BISECT_MAX {
             if lo.count <= MAX_LOCAL {
                 if let Some(roots) = self.localise(&lo) {

@@ -98,6 +98,11 @@ fn small_networks() -> Vec<(&'static str, Network)> {
         ("paper s3 20", paper7(s3(), 20)),
         ("paper s2 20", paper7(observer(9.0, 14.0, 8.0, 13.0), 20)),
         ("paper s3 0", paper7(s3(), 0)),
+        (
+            "path s2 delay-independent",
+            path3(observer(9.0, 14.0, 8.0, 13.0), [5, 10, 20, 0], false),
+        ),
+        ("paper s3 unstable", paper7(observerless(1.9, -0.3), 20)),
         ("path s3 per-link", path3(s3(), [5, 10, 20, 0], false)),
         ("path s2 per-link", path3(s2(), [5, 10, 20, 0], false)),
         ("chain 20 s3", chain(20, s3(), 20)),
@@ -236,36 +241,30 @@ fn a_tree_paths_systems_are_the_dense_ones() {
 /// and left of the axis, the margin's crossing is on the axis. Time it
 /// from the command line (`time cargo test --release … a_thousand_agents
 /// -- --nocapture`).
-#[test]
-fn a_thousand_agents() {
-    for (name, scheme) in [("scheme 3", s3()), ("scheme 2", s2())] {
-        let net = random_tree(1000, 10, scheme, 42, |_| 20);
-        let lin = Linearisation::of(&net).expect("tree path");
-        assert!(lin.on_trees(), "{name}");
-        let r = lin.rightmost_detail();
-        println!(
-            "{name}: rightmost {} ({:?}, axis {:?})",
-            r.root, r.part, r.axis
-        );
-        assert!(r.converged && r.root.re < 0.0, "{name}: {r:?}");
-        let m = lin.margin();
-        println!("{name}: margin {m:?}");
-        if let Margin::Crossing { axis_distance, .. } = m {
-            assert!(axis_distance < 1e-8, "{name}: {m:?}");
-        }
-    }
+fn a_thousand_agents(name: &str, scheme: Scheme) {
+    let net = random_tree(1000, 10, scheme, 42, |_| 20);
+    let lin = Linearisation::of(&net).expect("tree path");
+    assert!(lin.on_trees(), "{name}");
+    let r = lin.rightmost_detail();
+    println!(
+        "{name}: rightmost {} ({:?}, axis {:?})",
+        r.root, r.part, r.axis
+    );
+    assert!(r.converged && r.root.re < 0.0, "{name}: {r:?}");
+    let m = lin.margin();
+    println!("{name}: margin {m:?}");
+    let Margin::Crossing { axis_distance, .. } = m else {
+        panic!("{name}: {m:?}")
+    };
+    assert!(axis_distance < 1e-8, "{name}: {m:?}");
 }
 
 #[test]
-fn debug_scratch() {
-    use std::sync::atomic::Ordering::Relaxed;
-    use super::contour::{CONTOURS, EVALS};
-    for (name, scheme) in [("s3", s3()), ("s2", s2())] {
-        let net = random_tree(1000, 10, scheme, 42, |_| 20);
-        let lin = Linearisation::of(&net).expect("tree");
-        let r = lin.rightmost_detail();
-        println!("{name} rightmost {r:?}: contours {} evals {}", CONTOURS.swap(0, Relaxed), EVALS.swap(0, Relaxed));
-        let m = lin.margin();
-        println!("{name} margin {m:?}: contours {} evals {}", CONTOURS.swap(0, Relaxed), EVALS.swap(0, Relaxed));
-    }
+fn a_thousand_agents_scheme_3() {
+    a_thousand_agents("scheme 3", s3());
+}
+
+#[test]
+fn a_thousand_agents_scheme_2() {
+    a_thousand_agents("scheme 2", s2());
 }

@@ -173,8 +173,9 @@ fn pick_duration(
          gains' and the graph's eigenvalue extremes) decays at {rate:.3e} 1/s, so converging \
          to 1e-6 would need about {CONVERGE_MULTIPLE} × ln(1e6)/rate = {t:.0} s \
          (docs/stiffness.md); the real network may be slower (large initial errors, the \
-         coupling of the modes): `attsync run --until settled` extends a run until its \
-         verdict is final (docs/verdicts.md)"
+         coupling of the modes): `attsync margin FILE` gives the linearisation's exact \
+         slowest rate, and `attsync run --until settled` extends a run until its verdict \
+         is final (docs/verdicts.md)"
     );
     match given {
         Some(d) if d < t => {
