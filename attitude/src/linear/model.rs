@@ -48,6 +48,12 @@ use nalgebra::Complex;
 /// ([`LinearError::TooLarge`]).
 pub const DENSE_LIMIT: usize = 1000;
 
+/// Above this dense size a network that can take the tree path takes it:
+/// the dense method's cost grows as the cube of its size (0.03 s at 140,
+/// 0.5 s at 400, 12 s at 1000 on the 2-core reference machine), the tree
+/// path's about linearly with the agents (BENCHMARKS.md).
+pub const DENSE_PREFERRED: usize = 300;
+
 /// The most agents the tree path takes (`O(N)` memory and work per
 /// evaluation of `det Δ`; beyond, [`LinearError::TooLarge`]).
 pub const TREE_LIMIT: usize = 200_000;
@@ -154,18 +160,20 @@ impl Linearisation {
         gains: (f64, f64),
         split: bool,
     ) -> Result<Self, LinearError> {
-        let size = blocks::dense_size(net, part == Part::Observer, split);
-        let blocks = if size <= DENSE_LIMIT {
-            blocks::dense(net, part == Part::Observer, gains, split)
-        } else {
-            let too_large = LinearError::TooLarge {
-                states: size,
-                limit: DENSE_LIMIT,
-            };
-            if !split || net.agents.len() > TREE_LIMIT {
-                return Err(too_large);
+        let observer = part == Part::Observer;
+        let size = blocks::dense_size(net, observer, split);
+        let tree = (size > DENSE_PREFERRED && split && net.agents.len() <= TREE_LIMIT)
+            .then(|| blocks::trees(net, observer, gains).ok())
+            .flatten();
+        let blocks = match tree {
+            Some(trees) => trees,
+            None if size <= DENSE_LIMIT => blocks::dense(net, observer, gains, split),
+            None => {
+                return Err(LinearError::TooLarge {
+                    states: size,
+                    limit: DENSE_LIMIT,
+                });
             }
-            blocks::trees(net, part == Part::Observer, gains).map_err(|_| too_large)?
         };
         Ok(Self {
             part,
@@ -384,6 +392,17 @@ impl Linearisation {
     pub(crate) fn of_full(net: &Network) -> Result<Self, LinearError> {
         let me = Self::of(net)?;
         Self::build(net, me.part, me.loop_gains(net), false)
+    }
+
+    /// [`Self::of`] on the dense path whatever the size (the reference the
+    /// tree path is checked against).
+    #[cfg(test)]
+    pub(crate) fn of_dense(net: &Network) -> Result<Self, LinearError> {
+        let me = Self::of(net)?;
+        let split = me.per_axis();
+        let observer = me.part == Part::Observer;
+        let blocks = blocks::dense(net, observer, me.loop_gains(net), split);
+        Ok(Self { blocks, ..me })
     }
 
     /// [`Self::of`] on the tree path whatever the size (a check against

@@ -700,12 +700,16 @@ fn refusals() {
     });
     assert!(Linearisation::of(&net).is_ok());
 
-    // Too many agents for dense matrices: a chain of 40 agents is per axis
-    // n = 80 with p = 40 delayed, 80 + 40·18 = 800 fits; 60: 120 + 1080
-    // goes to the tree path; closed into a ring (not a forest), or with
-    // gains that are not diagonal (no split into axes), it is refused.
-    let small = Linearisation::of(&chain(40, observerless(1.9, 1.9), 3)).expect("dense");
+    // Dense matrices for small networks: a chain of 10 agents is per axis
+    // n = 20 with p = 10 delayed, 20 + 10·18 = 200 ≤ DENSE_PREFERRED; a
+    // chain of 40 (80 + 40·18 = 800) would fit but takes the faster tree
+    // path; 60 (120 + 1080) does not fit. Closed into a ring (not a
+    // forest), or with gains that are not diagonal (no split into axes),
+    // it is refused.
+    let small = Linearisation::of(&chain(10, observerless(1.9, 1.9), 3)).expect("dense");
     assert!(!small.on_trees());
+    let forty = Linearisation::of(&chain(40, observerless(1.9, 1.9), 3)).expect("tree");
+    assert!(forty.on_trees());
     let large = Linearisation::of(&chain(60, observerless(1.9, 1.9), 3)).expect("tree");
     assert!(large.on_trees() && large.per_axis());
     let mut ring = chain(60, observerless(1.9, 1.9), 3);

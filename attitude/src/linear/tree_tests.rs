@@ -166,7 +166,7 @@ fn tree_systems(net: &Network) -> Vec<tree::Tree> {
 #[test]
 fn the_rightmost_roots_agree_with_the_dense_path() {
     for (name, net) in small_networks() {
-        let dense = Linearisation::of(&net).expect("dense");
+        let dense = Linearisation::of_dense(&net).expect("dense");
         assert!(!dense.on_trees(), "{name}");
         let tree = Linearisation::of_tree(&net).expect("tree");
         let pairs = [
@@ -186,7 +186,7 @@ fn the_rightmost_roots_agree_with_the_dense_path() {
 #[test]
 fn the_margins_agree_with_the_dense_path() {
     for (name, net) in small_networks() {
-        let dense = Linearisation::of(&net).expect("dense").margin();
+        let dense = Linearisation::of_dense(&net).expect("dense").margin();
         let tree = Linearisation::of_tree(&net).expect("tree").margin();
         println!("{name:>22}: dense {dense:?}\n{:>22}  tree  {tree:?}", "");
         match (dense, tree) {
@@ -221,7 +221,7 @@ fn the_margins_agree_with_the_dense_path() {
 fn a_tree_paths_systems_are_the_dense_ones() {
     let net = path3(s2(), [5, 10, 20, 0], false);
     let (a, b) = (
-        Linearisation::of(&net).expect("dense"),
+        Linearisation::of_dense(&net).expect("dense"),
         Linearisation::of_tree(&net).expect("tree"),
     );
     assert_eq!(a.delays(), b.delays());
