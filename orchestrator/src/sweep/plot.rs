@@ -100,6 +100,7 @@ pub(super) fn draw(
         .configure_mesh()
         .x_desc(param)
         .y_desc("decay rate [1/s] (< 0: decays)")
+        .y_label_formatter(&|v| format!("{:.3}", if v.abs() < 1e-12 { 0.0 } else { *v }))
         .draw()
         .map_err(|e| e.to_string())?;
     let e = |e: DrawingAreaErrorKind<_>| e.to_string();
