@@ -68,7 +68,8 @@ fn config(
     connect: &[String],
     lowlatency: bool,
 ) -> anyhow::Result<zenoh::Config> {
-    let mut c = attsync::remote::zconfig::peer(listen, connect)?;
+    let insecure = attsync::trust::Security::Insecure;
+    let mut c = attsync::remote::zconfig::peer(listen, connect, &insecure)?;
     if !lowlatency {
         for (k, v) in [
             ("transport/unicast/lowlatency", "false"),

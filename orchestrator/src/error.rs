@@ -72,6 +72,10 @@ pub enum Error {
     /// The signal handler could not be installed.
     #[error("installing the signal handler: {0}")]
     Signals(std::io::Error),
+    /// Security flags that cannot be used (`--ca`, `--cert`, `--key`,
+    /// `--insecure`, `--allow-plugin`, `--gen-certs`).
+    #[error(transparent)]
+    Trust(#[from] crate::trust::TrustError),
     /// `attsync host` could not start or serve.
     #[error("attsync host: {0}")]
     Host(#[from] crate::remote::daemon::HostError),
@@ -101,6 +105,7 @@ impl Error {
             },
             Error::Mc(e) => e.exit_code(),
             Error::Host(e) => e.exit_code(),
+            Error::Trust(e) => e.exit_code(),
             _ => 1,
         }
     }

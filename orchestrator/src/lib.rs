@@ -19,6 +19,8 @@
 //! - [`verify`]: `attsync verify`, a run's files against its `manifest.json`
 //!   and a re-run of its scenario against its `states.bin` and `errors.csv`.
 //! - [`options`]: range checks of command-line options, before anything starts.
+//! - [`trust`]: who may talk to a daemon (mutual TLS or `--insecure`), the
+//!   plug-ins it may start, `--gen-certs`.
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
 //! - [`error`]: [`enum@Error`], every way a command fails, and its exit code.
 //! - [`view`]: `view.html`, a run in 3D in the browser (one self-contained file).
@@ -45,6 +47,7 @@ pub mod results;
 pub mod run;
 pub mod scenario;
 pub mod sweep;
+pub mod trust;
 pub mod until;
 pub mod verify;
 pub mod view;

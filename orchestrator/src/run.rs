@@ -241,7 +241,8 @@ fn plan(loaded: &Loaded, opts: &RunOptions) -> Result<Option<crate::remote::Plan
     };
     let placement = Placement::of(hosts, &loaded.resolved.network)?;
     tracing::debug!(cut_edges = placement.cut_edges().len(), "run: placed");
-    Ok(Some(crate::remote::Plan::of(&placement)))
+    let security = hosts.settled(None)?;
+    Ok(Some(crate::remote::Plan::of(&placement, security)))
 }
 
 /// Where the snapshots of one attempt go: `errors.csv`, `states.bin`, the
@@ -531,7 +532,15 @@ fn summarise(
         threads: None,
         verdict: Some(judged.verdict),
         until: judged.until,
+        hosts: opts.hosts.as_ref().and_then(hosts_summary),
     }
+}
+
+/// `summary.json`'s `hosts` of a run across `hosts` (its security settled).
+fn hosts_summary(hosts: &Hosts) -> Option<results::summary::HostsSummary> {
+    let names = hosts.hosts.iter().map(|h| h.name.clone()).collect();
+    let security = hosts.settled(None).ok()?;
+    Some(results::summary::HostsSummary::of(names, &security))
 }
 
 /// Writes the plot, then `summary.json` (last: it marks the directory as

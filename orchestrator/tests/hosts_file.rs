@@ -16,6 +16,8 @@ use std::path::{Path, PathBuf};
 /// A hosts file for the paper's scenario: the leader and agents 1, 3 on
 /// `lab-a`, 4, 5 on `lab-b`, 2, 6, 7 local.
 const SPLIT: &str = r#"
+insecure = true
+
 [[host]]
 name = "lab-a"
 endpoint = "tcp/127.0.0.1:7447"
@@ -272,7 +274,7 @@ fn names_endpoints_the_leader_and_agents_are_checked_at_once() {
             ),
             (
                 "host[0].endpoint",
-                "`udp/127.0.0.1:7447` is not a TCP endpoint (`udp`)",
+                "`udp/127.0.0.1:7447` is not a QUIC, TLS or TCP endpoint (`udp`)",
             ),
             ("host[0].agents[1]", "0 is the leader's node, not an agent"),
             (
@@ -384,7 +386,8 @@ fn attsync_in(dir: &Path, args: &[&dyn AsRef<OsStr>]) -> common::Out {
 fn run_and_sweep_refuse_a_bad_or_misfitting_hosts_file_before_anything_starts() {
     let (dir, bad) = write("bad.toml", &host("a", EP, "agents = [1, 1]"));
     let unknown = dir.path().join("unknown.toml");
-    fs::write(&unknown, host("a", EP, "agents = [9]")).unwrap();
+    let insecure = format!("insecure = true\n{}", host("a", EP, "agents = [9]"));
+    fs::write(&unknown, insecure).unwrap();
     let out = dir.path().join("out");
     let run = |hosts: &Path| {
         let args: [&dyn AsRef<OsStr>; 7] = [
@@ -415,8 +418,9 @@ fn run_and_sweep_refuse_a_bad_or_misfitting_hosts_file_before_anything_starts() 
         ("sweep", sweep(&unknown), &missing),
     ] {
         o.assert_code(2);
+        // (After `insecure = true`'s warning.)
         assert!(
-            o.stderr.starts_with(expected.as_str()),
+            o.stderr.lines().any(|l| l.starts_with(expected.as_str())),
             "{what}: {}",
             o.stderr
         );
@@ -438,10 +442,57 @@ fn hosts_need_the_process_engine_and_conform_says_it_runs_on_this_machine_only()
     let out = attsync_in(dir.path(), &args);
     out.assert_code(2);
     let expected = "error: --hosts needs --engine processes";
-    assert!(out.stderr.starts_with(expected), "{}", out.stderr);
+    assert!(
+        out.stderr.lines().any(|l| l.starts_with(expected)),
+        "{}",
+        out.stderr
+    );
     let args: [&dyn AsRef<OsStr>; 5] = [&"conform", &"--hosts", &hosts, &"--", &"true"];
     let out = attsync_in(dir.path(), &args);
     out.assert_code(2);
     let expected = "error: --hosts: conform runs one candidate on this machine only";
     assert!(out.stderr.starts_with(expected), "{}", out.stderr);
+}
+
+#[test]
+fn a_run_across_hosts_says_how_to_secure_it_and_refuses_tls_over_tcp() {
+    let (dir, none) = write("none.toml", &host("a", EP, "agents = [1]"));
+    let tls = dir.path().join("tls.toml");
+    let text = format!(
+        "insecure = true\n{}",
+        host("a", "tls/127.0.0.1:7447", "agents = [1]")
+    );
+    fs::write(&tls, text).unwrap();
+    let out = dir.path().join("out");
+    let run = |hosts: &Path, extra: &[&str]| {
+        let mut args: Vec<&dyn AsRef<OsStr>> = vec![
+            &"run", &PAPER, &"--quiet", &"--out", &out, &"--hosts", &hosts,
+        ];
+        args.extend(extra.iter().map(|e| e as &dyn AsRef<OsStr>));
+        attsync_in(dir.path(), &args)
+    };
+    let o = run(&none, &[]);
+    o.assert_code(2);
+    let expected = format!("{}: tls: no security: add a [tls] table", none.display());
+    assert!(o.stderr.starts_with(&expected), "{}", o.stderr);
+    // TLS over TCP is refused, with its reason.
+    let o = run(&tls, &[]);
+    o.assert_code(2);
+    assert!(
+        o.stderr.contains("host[0].endpoint: `tls/127.0.0.1:7447`"),
+        "{}",
+        o.stderr
+    );
+    assert!(o.stderr.contains("zenoh#2557"), "{}", o.stderr);
+    let o = run(
+        &none,
+        &["--ca", "/nonexistent/ca.pem", "--cert", "c", "--key", "k"],
+    );
+    o.assert_code(2);
+    assert!(
+        o.stderr.contains("--ca: /nonexistent/ca.pem: "),
+        "{}",
+        o.stderr
+    );
+    assert!(!out.exists(), "nothing is written");
 }

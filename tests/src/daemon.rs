@@ -1,10 +1,13 @@
 //! `attsync host` daemons for the tests across hosts ([`Daemon`]): each in
 //! a [`HostSandbox`] of its own (private `/dev/shm`, own `TMPDIR`), so
 //! nothing can pass between hosts through shared memory; Zenoh over
-//! 127.0.0.1 only, on a free port. Killed when dropped.
+//! 127.0.0.1 only, on a free port; mutual TLS over QUIC with the test CA
+//! ([`crate::certs`]) unless the endpoint is `tcp/` (then `--insecure`).
+//! Killed when dropped.
 
+use crate::certs::{self, Identity};
 use crate::command::{Attsync, run_args};
-use crate::hosts::{HostProcess, HostSandbox, free_port};
+use crate::hosts::{HostProcess, HostSandbox, free_udp_port};
 use crate::workspace::bin;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus};
@@ -20,15 +23,29 @@ pub struct Daemon {
     /// Where it listens (its endpoint, unless a relay is in between).
     listen: String,
     connect: Vec<String>,
+    /// Its identity (mutual TLS), `None` when insecure (`tcp/`).
+    identity: Option<Identity>,
+    /// Extra flags (`--allow-plugin PATH`…).
+    extra: Vec<String>,
     process: Option<HostProcess>,
 }
 
 impl Daemon {
-    /// Starts host `name` on a free port, dialling the hosts `connect`.
+    /// Starts host `name` on a free port (mutual TLS over QUIC), dialling
+    /// the hosts `connect`.
     #[must_use]
     pub fn start(name: &str, connect: &[&Daemon]) -> Self {
-        let endpoint = format!("tcp/127.0.0.1:{}", free_port());
-        Self::start_on(HostSandbox::new(name), &endpoint, endpoint.clone(), connect)
+        Self::start_with(name, connect, &[])
+    }
+
+    /// As [`Daemon::start`], with `extra` flags (`--allow-plugin PATH`…).
+    #[must_use]
+    pub fn start_with(name: &str, connect: &[&Daemon], extra: &[String]) -> Self {
+        let endpoint = format!("quic/127.0.0.1:{}", free_udp_port());
+        let mut d = Self::new(HostSandbox::new(name), &endpoint, endpoint.clone(), connect);
+        d.extra = extra.to_vec();
+        d.restart();
+        d
     }
 
     /// Starts a daemon in `host`, listening on `listen`, dialled by the
@@ -40,15 +57,33 @@ impl Daemon {
         endpoint: String,
         connect: &[&Daemon],
     ) -> Self {
-        let mut d = Self {
+        let mut d = Self::new(host, listen, endpoint, connect);
+        d.restart();
+        d
+    }
+
+    /// Not started yet: its identity, if its endpoint is not `tcp/`,
+    /// names the addresses it listens and is dialled at.
+    fn new(host: HostSandbox, listen: &str, endpoint: String, connect: &[&Daemon]) -> Self {
+        let identity = (!listen.starts_with("tcp/")).then(|| {
+            let addresses = [certs::address_of(listen), certs::address_of(&endpoint)];
+            certs::host(host.name(), &addresses)
+        });
+        Self {
             host,
             endpoint,
             listen: listen.to_string(),
             connect: connect.iter().map(|c| c.endpoint.clone()).collect(),
+            identity,
+            extra: Vec::new(),
             process: None,
-        };
-        d.restart();
-        d
+        }
+    }
+
+    /// Whether it runs without authentication (`--insecure`, `tcp/`).
+    #[must_use]
+    pub fn insecure(&self) -> bool {
+        self.identity.is_none()
     }
 
     /// Its name.
@@ -64,6 +99,11 @@ impl Daemon {
         for c in &self.connect {
             cmd.args(["--connect", c]);
         }
+        match &self.identity {
+            Some(id) => cmd.args(id.flags()),
+            None => cmd.arg("--insecure"),
+        };
+        cmd.args(&self.extra);
         cmd.env("ATTSYNC_LOG", "info").env_remove("ATTSYNC_BIN_DIR");
         self.process = Some(self.host.spawn(&cmd));
     }
@@ -123,10 +163,20 @@ impl Daemon {
 }
 
 /// Writes `dir/name`, a HOSTS.toml placing on each `(daemon, leader,
-/// agents)` the leader (if `leader`) and `agents`.
+/// agents)` the leader (if `leader`) and `agents`; with the test user's
+/// `[tls]` table, or `insecure = true` if the daemons are.
 #[must_use]
 pub fn hosts_file(dir: &Path, name: &str, hosts: &[(&Daemon, bool, &[u32])]) -> PathBuf {
-    let mut text = String::new();
+    let insecure = hosts.iter().all(|(d, _, _)| d.insecure());
+    assert!(
+        insecure || hosts.iter().all(|(d, _, _)| !d.insecure()),
+        "a hosts file's daemons are all secure or all insecure"
+    );
+    let mut text = if insecure {
+        "insecure = true\n\n".to_string()
+    } else {
+        certs::user().table()
+    };
     for (d, leader, agents) in hosts {
         text.push_str(&format!(
             "[[host]]\nname = \"{}\"\nendpoint = \"{}\"\nleader = {leader}\nagents = {agents:?}\n\n",

@@ -315,6 +315,13 @@ pub fn free_port() -> u16 {
     listener.local_addr().expect("a bound address").port()
 }
 
+/// A UDP port on 127.0.0.1 that was free a moment ago (QUIC endpoints).
+#[must_use]
+pub fn free_udp_port() -> u16 {
+    let socket = std::net::UdpSocket::bind(("127.0.0.1", 0)).expect("a free port");
+    socket.local_addr().expect("a bound address").port()
+}
+
 /// Whether the holder said it is ready (within [`SETUP_TIMEOUT`]).
 fn ready(holder: &mut Child) -> bool {
     let stdout = holder.stdout.take().expect("piped");

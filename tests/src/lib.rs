@@ -52,6 +52,7 @@
 //! Every wait is bounded ([`wait_until`], [`RUN_TIMEOUT`]); nothing asserts
 //! wall-clock durations.
 
+pub mod certs;
 mod command;
 mod conform;
 mod daemon;
@@ -72,7 +73,7 @@ pub use conform::{rule_line, run_conform};
 pub use daemon::{Daemon, assert_hosts_clean, assert_serves_again, hosts_file, run_on_hosts};
 pub use delay_relay::DelayRelay;
 pub use delayed_host::{DAEMON_PORT, DelayKind, DelayedHost};
-pub use hosts::{HostProcess, HostSandbox, free_port};
+pub use hosts::{HostProcess, HostSandbox, free_port, free_udp_port};
 pub use namespace::{
     iox_base, kill9, node_pid, owned_run, owned_runs, run_leftovers, run_processes, signal,
 };

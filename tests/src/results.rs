@@ -126,7 +126,7 @@ pub fn assert_same_results(a: &Path, b: &Path) {
             b.display()
         ),
     }
-    let skip = ["engine", "wall_seconds", "nodes", "threads"];
+    let skip = ["engine", "wall_seconds", "nodes", "threads", "hosts"];
     assert_eq!(
         summary_without(a, &skip),
         summary_without(b, &skip),

@@ -48,11 +48,17 @@ fn saturated_scenario(tmp: &Sandbox) -> PathBuf {
     file
 }
 
+/// `--allow-plugin /bin/sh`: the plug-ins here start through `sh -c`.
+fn allow_sh() -> Vec<String> {
+    vec!["--allow-plugin".into(), "/bin/sh".into()]
+}
+
 #[test]
 fn a_plugin_on_a_remote_host_gives_the_results_of_one_machine() {
     let tmp = Sandbox::new("hosts-plugin");
     let scenario = saturated_scenario(&tmp);
-    let a = Daemon::start("a", &[]);
+    // The plug-in starts through `sh`: the daemon must allow it.
+    let a = Daemon::start_with("a", &[], &allow_sh());
     let hosts = hosts_file(tmp.path(), "hosts.toml", &[(&a, false, &[3, 5])]);
     // Run from elsewhere: the plug-in's directory is the scenario's.
     let elsewhere = tmp.join("elsewhere");
@@ -239,7 +245,7 @@ fn a_remote_nodes_log_in_the_results_is_its_end_and_says_what_was_cut() {
     let agent = format!(", {:?}]\n", bin("attsync-agent").display().to_string());
     let extra = sh_plugin(&script).replacen("]\n", &agent, 1);
     let file = with_agent_lines(&tmp, &paper("constant-observerless"), 3, "chatty", &extra);
-    let a = Daemon::start("a", &[]);
+    let a = Daemon::start_with("a", &[], &allow_sh());
     let hosts = hosts_file(tmp.path(), "hosts.toml", &[(&a, false, &[3])]);
     let out = tmp.join("results");
     run_on_hosts(tmp.path(), &file, &out, &["simulation.duration=1"], &hosts)

@@ -1,11 +1,13 @@
-//! A host's Zenoh endpoint, `tcp/<address>:<port>`: the only shape a hosts
-//! file accepts (Zenoh's locator syntax, TCP only, no `?metadata` or
-//! `#configuration` suffix).
+//! A host's Zenoh endpoint, `quic/<address>:<port>` (mutual TLS),
+//! `tcp/<address>:<port>` (insecure) or `tls/…` (refused later, with its
+//! reason, by [`crate::trust::Security::endpoint_problem`]): the only shapes a hosts file accepts (Zenoh's locator syntax, no
+//! `?metadata` or `#configuration` suffix). Which of the two a file may use
+//! is its security's business ([`crate::trust::Security::endpoint_problem`]).
 
 use std::net::{Ipv4Addr, Ipv6Addr};
 
-/// The one protocol accepted.
-const TCP: &str = "tcp/";
+/// The protocols accepted.
+const PROTOCOLS: [&str; 3] = ["quic/", "tcp/", "tls/"];
 
 /// Longest DNS name (RFC 1035), in bytes.
 const MAX_NAME_BYTES: usize = 253;
@@ -13,12 +15,12 @@ const MAX_NAME_BYTES: usize = 253;
 /// Longest DNS label (RFC 1035), in bytes.
 const MAX_LABEL_BYTES: usize = 63;
 
-/// Why `endpoint` is not `tcp/<address>:<port>`, if it is not.
+/// Why `endpoint` is not `<protocol>/<address>:<port>`, if it is not.
 pub(super) fn problem(endpoint: &str) -> Option<String> {
-    let Some(rest) = endpoint.strip_prefix(TCP) else {
+    let Some(rest) = PROTOCOLS.iter().find_map(|p| endpoint.strip_prefix(p)) else {
         let protocol = endpoint.split_once('/').map_or(endpoint, |(p, _)| p);
         return Some(format!(
-            "`{endpoint}` is not a TCP endpoint (`{protocol}`): write tcp/<ip-or-name>:<port>, e.g. tcp/127.0.0.1:7447"
+            "`{endpoint}` is not a QUIC, TLS or TCP endpoint (`{protocol}`): write quic/<ip-or-name>:<port>, e.g. quic/127.0.0.1:7447"
         ));
     };
     if rest.contains(['?', '#']) {
@@ -28,7 +30,7 @@ pub(super) fn problem(endpoint: &str) -> Option<String> {
     }
     let Some((address, port)) = rest.rsplit_once(':') else {
         return Some(format!(
-            "`{endpoint}` has no port: write tcp/<ip-or-name>:<port>"
+            "`{endpoint}` has no port: write quic/<ip-or-name>:<port>"
         ));
     };
     address_problem(address)
@@ -89,8 +91,10 @@ mod tests {
     use super::problem;
 
     #[test]
-    fn tcp_endpoints_are_accepted() {
+    fn tls_and_tcp_endpoints_are_accepted() {
         for ok in [
+            "quic/127.0.0.1:7447",
+            "quic/lab-pc-2.local:7447",
             "tcp/127.0.0.1:7447",
             "tcp/[::1]:1",
             "tcp/lab-pc-2.local:65535",
@@ -103,8 +107,11 @@ mod tests {
     #[test]
     fn every_other_shape_is_refused_with_its_reason() {
         for (bad, reason) in [
-            ("udp/127.0.0.1:7447", "not a TCP endpoint (`udp`)"),
-            ("127.0.0.1:7447", "not a TCP endpoint"),
+            (
+                "udp/127.0.0.1:7447",
+                "not a QUIC, TLS or TCP endpoint (`udp`)",
+            ),
+            ("127.0.0.1:7447", "not a QUIC, TLS or TCP endpoint"),
             ("tcp/127.0.0.1", "has no port"),
             (
                 "tcp/127.0.0.1:0",

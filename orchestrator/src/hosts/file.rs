@@ -12,13 +12,32 @@ use std::collections::hash_map::Entry;
 /// Longest host name, in characters (it goes into paths and key expressions).
 pub const MAX_NAME_CHARS: usize = 64;
 
-/// The whole file: `[[host]]` tables and nothing else.
+/// The whole file: `[[host]]` tables, and how the links are secured
+/// (`[tls]`, or `insecure = true`).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HostsFile {
+    /// Plain TCP without authentication (`tcp/` endpoints; warned about).
+    #[serde(default)]
+    pub insecure: bool,
+    /// The orchestrator's identity under mutual TLS (`quic/` endpoints).
+    #[serde(default)]
+    pub tls: Option<TlsTable>,
     /// The hosts, in file order.
     #[serde(default)]
     pub host: Vec<Host>,
+}
+
+/// `[tls]`: the user's files, relative to the hosts file's directory.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TlsTable {
+    /// The lab's CA certificate (PEM).
+    pub ca: std::path::PathBuf,
+    /// The user's certificate (PEM, signed by the CA).
+    pub cert: std::path::PathBuf,
+    /// The user's private key (PEM).
+    pub key: std::path::PathBuf,
 }
 
 /// One machine and the nodes it runs.
@@ -27,7 +46,8 @@ pub struct HostsFile {
 pub struct Host {
     /// Its name (`[A-Za-z0-9_-]+`, at most [`MAX_NAME_CHARS`], unique in the file).
     pub name: String,
-    /// Where its daemon listens, `tcp/<ip-or-name>:<port>` (Zenoh's syntax).
+    /// Where its daemon listens, `quic/<ip-or-name>:<port>` (Zenoh's
+    /// syntax; `tcp/…` when insecure).
     pub endpoint: String,
     /// Ids of the scenario's agents it runs (1-based, as in `[[agent]] id`).
     #[serde(default)]

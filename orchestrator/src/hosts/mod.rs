@@ -2,9 +2,14 @@
 //! of a scenario, and the links between machines that this makes.
 //!
 //! ```toml
+//! [tls]                            # mutual TLS (SECURITY.md); or `insecure = true`
+//! ca = "certs/ca.pem"              # paths relative to this file
+//! cert = "certs/alice.pem"
+//! key = "certs/alice.key"
+//!
 //! [[host]]
 //! name = "lab-a"                   # [A-Za-z0-9_-]+, unique
-//! endpoint = "tcp/10.0.0.2:7447"   # where its `attsync host` daemon listens
+//! endpoint = "quic/10.0.0.2:7447"  # where its `attsync host` daemon listens
 //! agents = [1, 3, 5]               # agent ids of the scenario (default: none)
 //! leader = true                    # on at most one host (default: false)
 //! ```
@@ -15,6 +20,9 @@
 //! leader, agents placed twice, empty hosts. [`Placement::of`] then checks
 //! it against a scenario's network (every agent exists) and works out the
 //! cut edges. Each stage reports every problem at once ([`HostsError`]).
+//! [`Hosts::secure`] settles how the links are secured (the file's `[tls]`
+//! or `insecure`, unless the command line says otherwise) and that every
+//! endpoint fits it.
 //!
 //! # Layout
 //! - [`mod@file`] — the format as serde types, and the rules a file must keep;
@@ -28,6 +36,7 @@ mod error;
 pub mod file;
 pub mod placement;
 pub mod report;
+mod security;
 
 pub use error::HostsError;
 pub use file::Host;
@@ -52,6 +61,9 @@ pub struct Hosts {
     pub path: PathBuf,
     /// Its `[[host]]` tables, in file order (a host's index is its place here).
     pub hosts: Vec<Host>,
+    /// How the links are secured: the file's (`[tls]`, `insecure`) until
+    /// [`Hosts::secure`] settles it; `None`, neither said.
+    pub security: Option<crate::trust::Security>,
 }
 
 /// Reads (at most [`MAX_FILE_BYTES`]) and checks the hosts file `path`:
@@ -67,12 +79,14 @@ pub fn load(path: &Path) -> Result<Hosts, HostsError> {
 pub fn load_str(path: &Path, text: &str) -> Result<Hosts, HostsError> {
     let parsed: file::HostsFile = crate::scenario::parse::typed(text)
         .map_err(|issues| HostsError::Invalid(path.to_owned(), issues))?;
-    let issues = file::check(&parsed.host);
+    let mut issues = file::check(&parsed.host);
+    let security = security::of_file(path, &parsed, &mut issues);
     if !issues.is_empty() {
         return Err(HostsError::Invalid(path.to_owned(), issues));
     }
     Ok(Hosts {
         path: path.to_owned(),
         hosts: parsed.host,
+        security,
     })
 }

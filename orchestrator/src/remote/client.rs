@@ -86,7 +86,7 @@ impl Remote {
     /// a ping (an error names the first host that does not).
     pub fn connect(plan: &Plan, run: &str) -> Result<Self, String> {
         let endpoints: Vec<String> = plan.hosts.iter().map(|h| h.endpoint.clone()).collect();
-        let session = zconfig::open(&[], &endpoints).map_err(|e| e.to_string())?;
+        let session = zconfig::open(&[], &endpoints, &plan.security).map_err(|e| e.to_string())?;
         let token = (session.liveliness())
             .declare_token(keys::orchestrator_alive(run))
             .wait()

@@ -1,13 +1,17 @@
 //! `attsync host`: the daemon of one machine. One Zenoh session (peer,
-//! explicit endpoints), a liveliness token `attsync/host/<name>/alive`, and
-//! three queryables: `ping`, `run` (start a run's nodes here, one thread
-//! per run, runs isolated by run id) and `end`. It runs until SIGINT,
-//! SIGTERM or SIGHUP, then kills and cleans up every run it still serves.
+//! explicit endpoints, mutual TLS unless `--insecure`: [`crate::trust`]), a
+//! liveliness token `attsync/host/<name>/alive`, and three queryables:
+//! `ping`, `run` (start a run's nodes here, one thread per run, runs
+//! isolated by run id; plug-ins only if allowed, [`Allowlist`]) and `end`.
+//! It runs until SIGINT, SIGTERM or SIGHUP, then kills and cleans up every
+//! run it still serves.
 
 use super::host_run::{self, Command};
 use super::keys;
 use super::wire::{EndRequest, RunOffer};
 use super::zconfig::{self, ConfigError};
+use crate::trust::Security;
+use crate::trust::allow::Allowlist;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{self, Sender};
@@ -26,6 +30,10 @@ pub struct HostOptions {
     pub listen: Vec<String>,
     /// Endpoints of other hosts it dials.
     pub connect: Vec<String>,
+    /// How its links are secured (every endpoint's protocol must match).
+    pub security: Security,
+    /// The plug-in programs it may start.
+    pub allow: Allowlist,
 }
 
 /// The daemon could not start or serve.
@@ -74,10 +82,10 @@ impl HostOptions {
             return Err(HostError::Invalid("--listen: at least one endpoint".into()));
         }
         for e in &self.listen {
-            zconfig::check_endpoint("--listen", e)?;
+            zconfig::check_endpoint("--listen", e, &self.security)?;
         }
         for e in &self.connect {
-            zconfig::check_endpoint("--connect", e)?;
+            zconfig::check_endpoint("--connect", e, &self.security)?;
         }
         Ok(())
     }
@@ -96,7 +104,7 @@ pub fn ping_text(name: &str) -> String {
 /// Serves until `stop` is set.
 pub fn serve(opts: &HostOptions, stop: &AtomicBool) -> Result<(), HostError> {
     opts.check()?;
-    let session = zconfig::open(&opts.listen, &opts.connect)?;
+    let session = zconfig::open(&opts.listen, &opts.connect, &opts.security)?;
     let name = opts.name.clone();
     let _token = (session.liveliness())
         .declare_token(keys::host_alive(&name))
@@ -117,11 +125,13 @@ pub fn serve(opts: &HostOptions, stop: &AtomicBool) -> Result<(), HostError> {
         .declare_queryable(keys::end(&name))
         .wait()
         .map_err(zerr)?;
-    tracing::info!(host = %name, listen = ?opts.listen, connect = ?opts.connect, "serving");
+    let allowed: Vec<_> = opts.allow.programs().iter().map(|p| p.display()).collect();
+    tracing::info!(host = %name, listen = ?opts.listen, connect = ?opts.connect,
+        security = opts.security.name(), plugins = ?allowed, "serving");
     let mut runs: HashMap<String, (Sender<Command>, JoinHandle<()>)> = HashMap::new();
     while !stop.load(Ordering::Relaxed) {
         if let Ok(Some(q)) = run_q.recv_timeout(Duration::from_millis(50)) {
-            accept(&session, &name, q, &mut runs);
+            accept(&session, (&name, &opts.allow), q, &mut runs);
         }
         while let Ok(Some(q)) = end_q.try_recv() {
             route_end(q, &runs);
@@ -146,10 +156,11 @@ fn payload<T: serde::de::DeserializeOwned>(q: &Query) -> Result<T, String> {
 }
 
 /// Starts the run offered by `q` on its own thread, which fetches the
-/// run's request ([`host_run::serve_offer`]).
+/// run's request and checks its plug-ins against `allow`
+/// ([`host_run::serve_offer`]).
 fn accept(
     session: &zenoh::Session,
-    name: &str,
+    (name, allow): (&str, &Allowlist),
     q: Query,
     runs: &mut HashMap<String, (Sender<Command>, JoinHandle<()>)>,
 ) {
@@ -168,7 +179,8 @@ fn accept(
     let (tx, rx) = mpsc::channel();
     let s = session.clone();
     let run = req.run.clone();
-    let t = std::thread::spawn(move || host_run::serve_offer(s, req, q, rx));
+    let allow = allow.clone();
+    let t = std::thread::spawn(move || host_run::serve_offer(s, req, q, rx, &allow));
     runs.insert(run, (tx, t));
 }
 

@@ -15,6 +15,7 @@ use super::wire::{EndReply, EndRequest, HostEvent, NodeEnd, RunOffer, RunRequest
 use crate::processes::namespace::Namespace;
 use crate::processes::node_log::last_bytes;
 use crate::processes::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
+use crate::trust::allow::{Allowlist, Asked};
 use iceoryx2::prelude::*;
 use msgs::bytes::Bytes;
 use msgs::config::Contention;
@@ -139,14 +140,38 @@ pub fn serve_offer(
     offer: RunOffer,
     reply: Query,
     commands: Receiver<Command>,
+    allow: &Allowlist,
 ) {
-    match fetch(&session, &offer) {
+    match fetch(&session, &offer).and_then(|r| admit(r, allow)) {
         Ok(req) => serve(session, req, reply, commands),
         Err(e) => {
-            tracing::warn!(run = %offer.run, "cannot fetch the run's request: {e}");
+            tracing::warn!(run = %offer.run, "refused: {e}");
             answer(&reply, &Err(e));
         }
     }
+}
+
+/// `req` with each plug-in's program and directory as [`Allowlist::admit`]
+/// checked them (canonical), or the first refusal, naming the host, the
+/// node and its command (nothing has started).
+fn admit(mut req: RunRequest, allow: &Allowlist) -> Result<RunRequest, String> {
+    for n in &mut req.nodes {
+        let Some(p) = &mut n.plugin else { continue };
+        let asked = Asked {
+            command: &p.command,
+            env: &p.env,
+            dir: &p.dir,
+        };
+        let admitted = allow.admit(&asked).map_err(|reason| {
+            format!(
+                "host {} refuses {}'s plug-in command {:?}: {reason}",
+                req.host, n.name, p.command
+            )
+        })?;
+        p.command[0] = admitted.program.to_string_lossy().into_owned();
+        p.dir = admitted.dir;
+    }
+    Ok(req)
 }
 
 /// The request of the run `offer` offers.

@@ -19,16 +19,19 @@ pub struct PlannedHost {
 }
 
 /// Every host of a run; nodes on none run on the orchestrator's machine.
-#[derive(Debug, Clone, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Plan {
     /// The hosts.
     pub hosts: Vec<PlannedHost>,
+    /// How the orchestrator's links to them are secured.
+    pub security: crate::trust::Security,
 }
 
 impl Plan {
-    /// The hosts of `p` (HOSTS.toml placed on a network) and their nodes.
+    /// The hosts of `p` (HOSTS.toml placed on a network) and their nodes,
+    /// reached as `security` says.
     #[must_use]
-    pub fn of(p: &crate::hosts::Placement) -> Self {
+    pub fn of(p: &crate::hosts::Placement, security: crate::trust::Security) -> Self {
         let hosts = (p.hosts().iter().enumerate())
             .map(|(i, h)| PlannedHost {
                 name: h.name.clone(),
@@ -36,7 +39,7 @@ impl Plan {
                 nodes: p.nodes_on(i).to_vec(),
             })
             .collect();
-        Self { hosts }
+        Self { hosts, security }
     }
 
     /// Where node `id` runs.
@@ -102,6 +105,7 @@ mod tests {
                 endpoint: "tcp/127.0.0.1:1".into(),
                 nodes: vec![2, 3],
             }],
+            security: crate::trust::Security::Insecure,
         };
         let a = Side::Host("a".into());
         let got: Vec<(u32, Side, Vec<u32>)> = links(&configs, &plan)

@@ -173,6 +173,34 @@ pub struct Summary {
     /// `--until settled`: how far the horizon was extended and why it stopped.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub until: Option<crate::until::UntilSummary>,
+    /// A run across hosts (`--hosts`): the hosts and how the links were secured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hosts: Option<HostsSummary>,
+}
+
+/// The hosts of a run across machines, and its links' security.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct HostsSummary {
+    /// The hosts' names, in the hosts file's order.
+    pub hosts: Vec<String>,
+    /// `mutual-tls` or `insecure` ([`crate::trust::Security::name`]).
+    pub security: String,
+    /// Why an insecure run is one ([`crate::trust::INSECURE_WARNING`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
+}
+
+impl HostsSummary {
+    /// Of the hosts `names`, reached as `security` says.
+    #[must_use]
+    pub fn of(names: Vec<String>, security: &crate::trust::Security) -> Self {
+        let insecure = *security == crate::trust::Security::Insecure;
+        Self {
+            hosts: names,
+            security: security.name().into(),
+            warning: insecure.then(|| crate::trust::INSECURE_WARNING.into()),
+        }
+    }
 }
 
 /// Where a run diverged: the first state outside the envelope
@@ -339,6 +367,9 @@ impl Summary {
         );
         if let Some(v) = &self.verdict {
             let _ = write!(s, "\nverdict: {}", verdict_line(v));
+        }
+        if let Some(w) = self.hosts.as_ref().and_then(|h| h.warning.as_ref()) {
+            let _ = write!(s, "\nwarning: {w}");
         }
         if let Some(u) = &self.until {
             let _ = write!(

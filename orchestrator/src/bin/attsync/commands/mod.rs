@@ -167,17 +167,44 @@ pub struct HostsArgs {
     /// machines"); nodes on no host run on this machine. Processes engine.
     #[arg(long, value_name = "HOSTS.toml")]
     pub hosts: Option<PathBuf>,
+    /// With --hosts: the lab's CA certificate (PEM), instead of the hosts
+    /// file's `[tls] ca`.
+    #[arg(long, value_name = "CA.pem", requires = "hosts")]
+    pub ca: Option<PathBuf>,
+    /// With --hosts: your certificate (PEM), instead of `[tls] cert`.
+    #[arg(long, value_name = "CERT.pem", requires = "hosts")]
+    pub cert: Option<PathBuf>,
+    /// With --hosts: your private key (PEM), instead of `[tls] key`.
+    #[arg(long, value_name = "KEY.pem", requires = "hosts")]
+    pub key: Option<PathBuf>,
+    /// With --hosts: plain TCP, nobody authenticated, nothing encrypted
+    /// (warned about; the daemons must be --insecure too).
+    #[arg(long, requires = "hosts")]
+    pub insecure: bool,
 }
 
 impl HostsArgs {
-    /// The hosts file, loaded and checked on its own (a bad one: exit 2,
-    /// before anything else).
+    /// The hosts file, loaded and checked on its own, its security settled
+    /// (the flags', else the file's) and its endpoints checked against it
+    /// (a bad one: exit 2, before anything else). Warns if insecure.
     pub fn load(&self) -> Result<Option<Hosts>, Error> {
-        Ok(self
-            .hosts
-            .as_deref()
-            .map(attsync::hosts::load)
-            .transpose()?)
+        let Some(path) = self.hosts.as_deref() else {
+            return Ok(None);
+        };
+        let hosts = attsync::hosts::load(path)?;
+        let flagged =
+            self.ca.is_some() || self.cert.is_some() || self.key.is_some() || self.insecure;
+        let given = flagged
+            .then(|| {
+                let (ca, cert, key) = (self.ca.clone(), self.cert.clone(), self.key.clone());
+                attsync::trust::choose(ca, cert, key, self.insecure, attsync::trust::FLAGS)
+            })
+            .transpose()?;
+        let hosts = hosts.secure(given)?;
+        if hosts.security == Some(attsync::trust::Security::Insecure) {
+            eprintln!("warning: {}", attsync::trust::INSECURE_WARNING);
+        }
+        Ok(Some(hosts))
     }
 }
 
