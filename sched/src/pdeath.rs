@@ -57,7 +57,7 @@ mod tests {
     #[test]
     fn the_child_dies_with_the_thread_that_spawned_it() {
         let t = std::thread::spawn(|| {
-            die_with_parent(&mut Command::new("sleep").arg("30"))
+            die_with_parent(Command::new("sleep").arg("30"))
                 .spawn()
                 .expect("spawn sleep")
         });
