@@ -54,14 +54,20 @@ pub fn create_node(cfg: &NodeConfig, name: &str) -> Result<Node<ipc::Service>, I
     msgs::iox::create_node(&cfg.run, std::path::Path::new(&cfg.iox_root), name)
 }
 
-/// The `main` of a node program `program`: parses `--config`, sets up
-/// tracing, reads the configuration, creates the iceoryx2 node named by
-/// `name`, runs `body`, and turns an error into a message and exit status 1.
+/// The `main` of a node program `program`: exits at once if its expected
+/// parent is already gone ([`msgs::parent::watched`]), parses `--config`,
+/// sets up tracing, reads the configuration, creates the iceoryx2 node
+/// named by `name`, runs `body`, and turns an error into a message and exit
+/// status 1.
 pub fn node_main(
     program: &str,
     name: impl FnOnce(&NodeConfig) -> String,
     body: impl FnOnce(&Node<ipc::Service>, &NodeConfig) -> Result<(), MainError>,
 ) -> ExitCode {
+    if let Err(orphaned) = msgs::parent::watched() {
+        eprintln!("{program}: {orphaned}");
+        return ExitCode::FAILURE;
+    }
     let args = <NodeArgs as clap::Parser>::parse();
     init_tracing();
     let result = NodeConfig::read(&args.config)

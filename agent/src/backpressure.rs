@@ -88,25 +88,26 @@ pub fn next_pause(pause: Duration, sent: u32, buffer: u32) -> Duration {
 /// A backpressure handler: sleep for the pacer's pause and retry until
 /// `timeout`, then give up on that receiver and fail the send (so nothing
 /// hangs). It also gives up at once when the node's parent (the
-/// orchestrator, whose pid is read when the handler is made) is gone: a
-/// dead receiver's buffer stays full, and a sender waiting on it must still
-/// exit within a second of the orchestrator's death (PROTOCOL.md § 6: a
-/// node exits if its parent process changes).
+/// orchestrator: [`msgs::parent::watched`] when the handler is made) is
+/// gone: a dead receiver's buffer stays full, and a sender waiting on it
+/// must still exit within a second of the orchestrator's death (PROTOCOL.md
+/// § 6: a node exits if its parent process changes).
 pub fn retry_until(
     timeout: Duration,
     pacer: Pacer,
 ) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send + 'static {
-    retry_until_parent(timeout, pacer, std::os::unix::process::parent_id())
+    retry_until_parent(timeout, pacer, msgs::parent::watched().ok())
 }
 
-/// [`retry_until`] for a node whose parent is `parent`.
+/// [`retry_until`] for a node whose parent is `parent` (`None`: already
+/// orphaned).
 fn retry_until_parent(
     timeout: Duration,
     pacer: Pacer,
-    parent: u32,
+    parent: Option<u32>,
 ) -> impl Fn(&BackpressureInfo) -> BackpressureAction + Send + 'static {
     move |info| {
-        let orphaned = || std::os::unix::process::parent_id() != parent;
+        let orphaned = || parent != Some(std::os::unix::process::parent_id());
         if info.elapsed_time > timeout || orphaned() {
             BackpressureAction::DiscardDataAndFail
         } else {
@@ -134,7 +135,7 @@ mod tests {
     fn a_full_receiver_is_retried_until_the_timeout_or_the_parents_death() {
         let parent = std::os::unix::process::parent_id();
         let timeout = Duration::from_secs(10);
-        let ours = retry_until_parent(timeout, Pacer::new(64), parent);
+        let ours = retry_until_parent(timeout, Pacer::new(64), Some(parent));
         assert!(matches!(
             ours(&full(Duration::ZERO)),
             BackpressureAction::Retry
@@ -145,7 +146,11 @@ mod tests {
             BackpressureAction::DiscardDataAndFail
         ));
         // A parent that is not ours any more: the orchestrator died.
-        let gone = retry_until_parent(timeout, Pacer::new(64), parent.wrapping_add(1));
+        let gone = retry_until_parent(timeout, Pacer::new(64), Some(parent.wrapping_add(1)));
+        let now = gone(&full(Duration::ZERO));
+        assert!(matches!(now, BackpressureAction::DiscardDataAndFail));
+        // Orphaned before the handler was made.
+        let gone = retry_until_parent(timeout, Pacer::new(64), None);
         let now = gone(&full(Duration::ZERO));
         assert!(matches!(now, BackpressureAction::DiscardDataAndFail));
     }

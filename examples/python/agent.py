@@ -708,17 +708,35 @@ def exchanges_at(coupling, step, stage):
 # § 3, § 4 iceoryx2 ports
 # ==========================================================================
 
-def open_service(name, make):
-    """open_or_create, retried for 2 s: two processes creating the same
-    service at once make one of them fail transiently."""
-    start = time.monotonic()
+# Pauses between two tries of an open (§ 6.2): short at first (two creators
+# at once sort it out within milliseconds), doubling up to 50 ms.
+FIRST_PAUSE, MAX_PAUSE = 0.002, 0.05
+# Words in iceoryx2's errors that retrying cannot mend: the service exists
+# with other settings (or another iceoryx2 version).
+LASTING = ("Incompatible", "DoesNotSupport", "VersionMismatch", "ExceedsMax",
+           "TypeDefinition")
+
+
+def open_service_until(name, make, deadline):
+    """open_or_create, retried until `deadline` (time.monotonic(); the start
+    timeout): another process may still be creating the service, and on a
+    busy machine iceoryx2's own wait for it (1 s) runs out. An error that
+    says the settings differ is not retried."""
+    start, pause, tries = time.monotonic(), FIRST_PAUSE, 0
     while True:
+        tries += 1
         try:
             return make()
         except Exception as e:  # iceoryx2 raises its own error types
-            if time.monotonic() - start > 2.0:
-                raise NodeError(f"cannot open service {name}: {e!r}") from e
-            time.sleep(0.005)
+            text = f"{type(e).__name__} {e!r}"
+            if any(word in text for word in LASTING):
+                raise NodeError(f"cannot open service {name}: {e!r} (not retried)") from e
+            if time.monotonic() + pause > deadline:
+                waited = time.monotonic() - start
+                raise NodeError(f"cannot open service {name}: not ready after {waited:.1f} s "
+                                f"({tries} tries); last error: {e!r}") from e
+            time.sleep(pause)
+            pause = min(2 * pause, MAX_PAUSE)
 
 
 class Ports:
@@ -749,6 +767,12 @@ class Ports:
 
         def service(name):
             return self.node.service_builder(iox2.ServiceName.new(f"attsync/{run}/{name}"))
+
+        # Every open is retried within the start timeout (§ 6.2).
+        deadline = time.monotonic() + float(cfg["start_timeout"])
+
+        def open_service(name, make):
+            return open_service_until(name, make, deadline)
 
         def state(j):
             return open_service(f"node/{j}/state", lambda: (
@@ -872,11 +896,26 @@ class Ports:
         gc.collect()
 
 
+def alive(pid):
+    """Whether process `pid` exists and is not a zombie."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] not in ("Z", "X")
+    except (OSError, IndexError):
+        return False
+
+
 class Orphan:
-    """Detects that the process that started us (the orchestrator) is gone."""
+    """Detects that the process that started us (the orchestrator) is gone
+    (§ 1, § 6): the parent to watch is ATTSYNC_PARENT_PID if that is our
+    parent, else (a wrapper between us) our parent while that pid lives; if
+    it is gone already, we were orphaned before we could look."""
 
     def __init__(self):
         self.parent = os.getppid()
+        expected = os.environ.get("ATTSYNC_PARENT_PID", "")
+        if expected.isdigit() and int(expected) != self.parent and not alive(int(expected)):
+            raise NodeError(f"the orchestrator (pid {expected}) has exited")
 
     def check(self):
         if os.getppid() != self.parent:

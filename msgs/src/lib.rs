@@ -14,6 +14,7 @@
 //! - [`names`]: service names under `attsync/<run>/…`.
 //! - [`open`]: the openers, with limits derived from the topology ([`Limits`]).
 //! - [`namespace`]: the per-run iceoryx2 configuration (file prefix, root path).
+//! - [`parent`]: the process a node dies with ([`parent::PARENT_PID_VAR`]).
 //! - [`iox`]: [`IoxError`](iox::IoxError) for any failed iceoryx2 call; [`create_node`](iox::create_node) in a run's namespace.
 
 pub mod bytes;
@@ -22,6 +23,7 @@ pub mod iox;
 pub mod names;
 pub mod namespace;
 pub mod open;
+pub mod parent;
 pub mod payload;
 pub mod telemetry;
 

@@ -22,7 +22,10 @@
 //! before.
 //!
 //! The two system calls here have no safe wrapper in `libc` or `nix`; they
-//! are the workspace's only unsafe code.
+//! and [`pdeath`] (a hook between `fork` and `exec`, unsafe by nature) are
+//! the workspace's only unsafe code.
+
+pub mod pdeath;
 
 use std::time::Duration;
 use thiserror::Error;

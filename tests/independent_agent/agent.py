@@ -93,6 +93,15 @@ def peak_rss_kb():
     return 0
 
 
+def alive(pid):
+    """Whether process `pid` exists and is not a zombie (/proc/<pid>/stat)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] not in ("Z", "X")
+    except (OSError, IndexError):
+        return False
+
+
 class Node:
     """The ports of § 4 and the waits of § 6 around one :class:`Agent`."""
 
@@ -102,6 +111,11 @@ class Node:
         self.cfg = cfg
         self.id = int(cfg["id"])
         self.ppid = os.getppid()
+        # § 1, § 6: orphaned before we could look if ATTSYNC_PARENT_PID is not
+        # our parent and is gone (or a zombie).
+        expected = os.environ.get("ATTSYNC_PARENT_PID", "")
+        if expected.isdigit() and int(expected) != self.ppid and not alive(int(expected)):
+            raise Exit(1, f"the parent process {expected} is gone")
         self.polling = cfg.get("wait") in ("spin", "yield")
         self.ports = ports.Ports(cfg)
 

@@ -23,7 +23,8 @@
 //! - `namespace.rs`: run namespaces (`<tmp>/attsync-iox2/<run>/` with an
 //!   `owner` file holding the orchestrator's pid, shared memory
 //!   `/dev/shm/as<run>_*`): [`iox_base`], [`owned_runs`], [`run_leftovers`],
-//!   [`run_processes`], [`node_pid`], [`owned_run`]; [`signal`], [`kill9`].
+//!   [`run_processes`], [`node_pid`], [`owned_run`], [`started_by`] (the
+//!   processes an orchestrator started, by their environment); [`signal`], [`kill9`].
 //! - `results.rs`: [`read`], [`assert_same_file`], [`assert_same_bytes`],
 //!   [`csv_agents`], [`csv_rows`], [`summary`], [`summary_without`],
 //!   [`assert_same_results`], [`staging_dir`].
@@ -76,6 +77,7 @@ pub use delayed_host::{DAEMON_PORT, DelayKind, DelayedHost};
 pub use hosts::{HostProcess, HostSandbox, free_port, free_udp_port};
 pub use namespace::{
     iox_base, kill9, node_pid, owned_run, owned_runs, run_leftovers, run_processes, signal,
+    started_by,
 };
 pub use netns::{Veth, link_exists};
 pub use python::{conform_python, require_iceoryx2_module};

@@ -155,6 +155,29 @@ pub fn node_pid(run: &str, id: u32) -> Option<u32> {
     })
 }
 
+/// Live processes started by orchestrator (or host daemon) `parent`, whether
+/// it is alive or not: those whose environment holds `ATTSYNC_PARENT_PID=<parent>`
+/// (every node, plug-ins included, and whatever they started), or with an
+/// argument in a run directory named after `parent`'s pid
+/// (`<base>/<pid in hex>r…`), found from `/proc` whatever their parent is now.
+#[must_use]
+pub fn started_by(parent: u32) -> Vec<u32> {
+    let var = format!("{}={parent}", msgs::parent::PARENT_PID_VAR);
+    let dir = format!("{}/{parent:x}r", iox_base().display());
+    let Ok(rd) = fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    rd.filter_map(Result::ok)
+        .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
+        .filter(|&pid| {
+            // (A zombie's environment and command line read empty.)
+            let env = fs::read(format!("/proc/{pid}/environ")).unwrap_or_default();
+            let by_env = env.split(|&c| c == 0).any(|kv| kv == var.as_bytes());
+            by_env || cmdline(pid).iter().any(|a| a.starts_with(&dir))
+        })
+        .collect()
+}
+
 /// Sends signal `sig` (`KILL`, `STOP`, `CONT`, …) to `pid` with `kill`;
 /// whether `kill` succeeded.
 pub fn signal(pid: u32, sig: &str) -> bool {

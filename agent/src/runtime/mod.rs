@@ -13,7 +13,9 @@
 //! Every received state is checked ([`StateMsg::validated`]); an invalid
 //! one is refused, counted and reported, and the node keeps the value it had.
 //! In every phase the node checks its parent at least every 100 ms and
-//! exits ([`NodeError::Orphaned`]) once the orchestrator is gone.
+//! exits ([`NodeError::Orphaned`]) once the orchestrator is gone; the
+//! parent it expects comes from [`msgs::parent::PARENT_PID_VAR`], so a node
+//! orphaned before its first look notices too.
 //!
 //! # Layout
 //! - `ports.rs`: every iceoryx2 port and the readiness barrier.
@@ -159,7 +161,7 @@ pub fn run_with<S: Service, N: Stepper, H: Hooks>(
     hooks: &mut H,
     shutdown: &AtomicBool,
 ) -> Result<(), NodeError> {
-    let orphan = Orphan::new();
+    let orphan = Orphan::new()?;
     let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
     let ports = Ports::open(node, cfg)?;
     ports.await_connections(cfg, &orphan)?;
@@ -329,11 +331,14 @@ pub(crate) struct Orphan {
 }
 
 impl Orphan {
-    fn new() -> Self {
-        Self {
-            parent: std::os::unix::process::parent_id(),
+    /// Watches the parent [`msgs::parent::watched`] names; fails at once if
+    /// the expected parent is already gone (died before we could look).
+    fn new() -> Result<Self, NodeError> {
+        let parent = msgs::parent::watched().map_err(|o| NodeError::Orphaned(o.parent))?;
+        Ok(Self {
+            parent,
             last_check: Cell::new(Instant::now()),
-        }
+        })
     }
 
     /// Fails if the parent is gone (checks now).

@@ -11,7 +11,7 @@ use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSub;
 use msgs::config::NodeConfig;
-use msgs::open;
+use msgs::open::Opener;
 use msgs::{ControlMsg, StateMsg, Telemetry, TelemetryMsg};
 use std::time::{Duration, Instant};
 
@@ -44,7 +44,11 @@ impl<S: Service> Ports<S> {
     pub fn open(node: &Node<S>, cfg: &NodeConfig) -> Result<Self, NodeError> {
         let (run, l, id) = (cfg.run.as_str(), &cfg.limits, cfg.id);
         let stage_timeout = Duration::from_secs_f64(cfg.stage_timeout);
-        let own = open::state(node, run, id, l)?;
+        let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
+        // Services other nodes are still creating are waited for, within
+        // the start timeout (PROTOCOL.md § 6.2).
+        let open = Opener::new(node, run, l).patience(start_timeout);
+        let own = open.state(id)?;
         let pacer = Pacer::new(l.state_buffer);
         let publisher = match cfg.realtime {
             None => own
@@ -57,11 +61,12 @@ impl<S: Service> Ports<S> {
         }
         .create()
         .map_err(port("state publisher"))?;
-        let listener = open::wake(node, run, id, l)?
+        let listener = open
+            .wake(id)?
             .listener_builder()
             .create()
             .map_err(port("wake listener"))?;
-        let tele = open::telemetry(node, run, id, l)?;
+        let tele = open.telemetry(id)?;
         let tele_pacer = Pacer::new(l.telemetry_buffer);
         let tele_pub = tele
             .publisher_builder()
@@ -69,18 +74,20 @@ impl<S: Service> Ports<S> {
             .set_backpressure_handler(retry_until(stage_timeout, tele_pacer.clone()))
             .create()
             .map_err(port("telemetry publisher"))?;
-        let orch_notifier = open::orchestrator_wake(node, run, l)?
+        let orch_notifier = open
+            .orchestrator_wake()?
             .notifier_builder()
             .create()
             .map_err(port("orchestrator notifier"))?;
-        let control = open::control(node, run, l)?
+        let control = open
+            .control()?
             .subscriber_builder()
             .create()
             .map_err(port("control subscriber"))?;
         let mut inputs = Vec::new();
         let mut input_services = Vec::new();
         for &j in &cfg.inputs {
-            let svc = open::state(node, run, j, l)?;
+            let svc = open.state(j)?;
             inputs.push(
                 svc.subscriber_builder()
                     .buffer_size(l.state_buffer)
@@ -93,7 +100,7 @@ impl<S: Service> Ports<S> {
             .outputs
             .iter()
             .map(|&j| {
-                open::wake(node, run, j, l)?
+                open.wake(j)?
                     .notifier_builder()
                     .create()
                     .map_err(port("wake notifier"))

@@ -77,7 +77,8 @@ pub(super) fn session(
     })?;
     let cfg = candidate_config(net, index, ns.run(), ns.dir(), opts);
     let limits = Limits::of(net);
-    let ports = Ports::open(ns, "conform", &limits, &[cfg.id])?;
+    let start_timeout = Duration::from_secs_f64(opts.start_timeout);
+    let ports = Ports::open(ns, "conform", &limits, &[cfg.id], start_timeout)?;
     let wires = Wires::open(&ports, &cfg, &limits)?;
     let file = (ports.dir()).join(crate::results::layout::node_config_file(cfg.id));
     cfg.write(&file)?;

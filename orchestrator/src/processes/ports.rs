@@ -12,6 +12,7 @@ use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use msgs::iox::{IoxError, create_node, iox};
+use msgs::open::Opener;
 use msgs::{ControlCommand, ControlMsg, Limits, TelemetryMsg};
 use std::path::Path;
 use std::time::Duration;
@@ -33,27 +34,32 @@ pub struct Ports {
 impl Ports {
     /// Opens, in namespace `ns`, an iceoryx2 node `name`, the control
     /// publisher, the wake listener and a telemetry subscriber for each node
-    /// id of `telemetry_of` (in that order), with `limits`.
+    /// id of `telemetry_of` (in that order), with `limits`; a service another
+    /// process is still creating is waited for, within `start_timeout`.
     pub fn open(
         ns: Namespace,
         name: &str,
         limits: &Limits,
         telemetry_of: &[u32],
+        start_timeout: Duration,
     ) -> Result<Self, ProcessError> {
         let run = ns.run().to_string();
         let node = create_node::<ipc::Service>(&run, ns.dir(), name)?;
-        let control = msgs::open::control(&node, &run, limits)?
+        let open = Opener::new(&node, &run, limits).patience(start_timeout);
+        let control = open
+            .control()?
             .publisher_builder()
             .create()
             .map_err(iox("control publisher"))?;
-        let wake = msgs::open::orchestrator_wake(&node, &run, limits)?
+        let wake = open
+            .orchestrator_wake()?
             .listener_builder()
             .create()
             .map_err(iox("wake listener"))?;
         let telemetry = telemetry_of
             .iter()
             .map(|&id| {
-                msgs::open::telemetry(&node, &run, id, limits)?
+                open.telemetry(id)?
                     .subscriber_builder()
                     .buffer_size(limits.telemetry_buffer)
                     .create()

@@ -34,7 +34,8 @@ impl<'a> Session<'a> {
         let ns = Namespace::create().map_err(io_at(&namespace::base_dir()))?;
         let n_nodes = net.agents.len() + 1;
         let ids: Vec<u32> = (0..n_nodes).map(|i| node_id(net, i)).collect();
-        let ports = super::Ports::open(ns, "orchestrator", &Limits::of(net), &ids)?;
+        let start_timeout = Duration::from_secs_f64(opts.start_timeout);
+        let ports = super::Ports::open(ns, "orchestrator", &Limits::of(net), &ids, start_timeout)?;
         let sup = Supervisor::new().map_err(io_at(Path::new("tokio runtime")))?;
         let remote = (opts.hosts.as_ref())
             .map(|plan| crate::remote::Remote::connect(plan, ports.run()))
@@ -120,7 +121,10 @@ impl<'a> Session<'a> {
         let limits = Limits::of(self.net);
         // A node that opened its ports has its telemetry publisher.
         let connected = |id: u32| {
-            msgs::open::telemetry(self.ports.node(), self.ports.run(), id, &limits)
+            // (A look, not a wait: the orchestrator created the service.)
+            msgs::open::Opener::new(self.ports.node(), self.ports.run(), &limits)
+                .patience(Duration::ZERO)
+                .telemetry(id)
                 .is_ok_and(|t| t.dynamic_config().number_of_publishers() > 0)
         };
         let (silent, waiting): (Vec<_>, Vec<_>) = (self.nodes.slots.iter())

@@ -4,6 +4,19 @@
 //! engine polls it ([`Supervisor::try_exit`]); `conform` waits on it
 //! ([`Supervisor::next_exit`]) and keeps a candidate's process group after it
 //! exits, to check it is empty ([`Supervisor::keep_groups`], [`group_members`]).
+//!
+//! Every node dies with the process that starts it, at any moment of that
+//! process's life: it gets `SIGKILL` from the kernel when its parent dies
+//! (`PR_SET_PDEATHSIG`, set before `exec`, [`attsync_sched::pdeath`]), and
+//! learns its parent's pid from [`msgs::parent::PARENT_PID_VAR`].
+//!
+//! CAUTION: the kernel sends that signal when the *thread* that forked
+//! exits. [`Supervisor::spawn`] forks on its caller's thread, so a
+//! supervisor must be used (and dropped) on one thread that lives until its
+//! nodes have ended: `processes::run` (on the main thread, or a sweep's or
+//! Monte Carlo's scoped worker, which returns only after the run's
+//! shutdown), `conform`'s candidate runs, and the host daemon's per-run
+//! thread (`remote/host_run.rs`) all do.
 
 use super::node_log;
 use std::os::unix::process::ExitStatusExt;
@@ -110,7 +123,9 @@ impl Supervisor {
     }
 
     /// Starts `program args…` as node `index` (with `env` added to the
-    /// environment, in `cwd` if given), stdout and stderr piped into `log`
+    /// environment, and [`msgs::parent::PARENT_PID_VAR`]; in `cwd` if
+    /// given), to die with the calling thread (see the module's caution),
+    /// stdout and stderr piped into `log`
     /// (cut at [`super::node_log::LOG_CAP`]). Returns its process id, or
     /// `None` if it could not start (its [`Exit`] says why).
     pub fn spawn(
@@ -133,8 +148,10 @@ impl Supervisor {
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
+            .env(msgs::parent::PARENT_PID_VAR, std::process::id().to_string())
             .process_group(0)
             .kill_on_drop(true);
+        attsync_sched::pdeath::die_with_parent(cmd.as_std_mut());
         let tx = self.exits_tx.clone();
         let mut kill = self.kill.subscribe();
         self.started += 1;
