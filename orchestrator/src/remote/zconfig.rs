@@ -16,16 +16,14 @@ pub const LEASE_MS: u64 = 2000;
 /// An endpoint Zenoh does not accept, or a session that cannot open.
 #[derive(Debug, Error)]
 pub enum ConfigError {
-    /// An endpoint is not in Zenoh's syntax (`tcp/127.0.0.1:7447`).
-    #[error(
-        "{flag}: `{endpoint}` is not an endpoint (expected e.g. quic/127.0.0.1:7447): {reason}"
-    )]
+    /// An endpoint is not in Zenoh's syntax, or not of the security's protocol.
+    #[error("{flag}: {reason}")]
     Endpoint {
         /// Where it came from (`--listen`, a host's `endpoint`…).
         flag: String,
         /// The text.
         endpoint: String,
-        /// Zenoh's reason.
+        /// Why not (naming the endpoint).
         reason: String,
     },
     /// The session did not open (a port taken, …).
@@ -41,7 +39,11 @@ pub fn check_endpoint(flag: &str, endpoint: &str, security: &Security) -> Result
         endpoint: endpoint.to_string(),
         reason,
     };
-    let _: zenoh::config::EndPoint = endpoint.parse().map_err(|e| bad(format!("{e}")))?;
+    let _: zenoh::config::EndPoint = endpoint.parse().map_err(|e| {
+        bad(format!(
+            "`{endpoint}` is not an endpoint (expected e.g. quic/127.0.0.1:7447): {e}"
+        ))
+    })?;
     match security.endpoint_problem(endpoint) {
         Some(reason) => Err(bad(reason)),
         None => Ok(()),
