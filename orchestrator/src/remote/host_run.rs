@@ -157,8 +157,14 @@ fn fetch(session: &zenoh::Session, offer: &RunOffer) -> Result<RunRequest, Strin
         .wait()
         .map_err(|e| format!("zenoh: {e}"))?;
     let bytes = pieces::collect(&replies).map_err(|e| format!("its request: {e}"))?;
+    decode_request(&bytes, offer)
+}
+
+/// The run request in `bytes` (put back together from its pieces) for the
+/// run `offer` offered: its JSON, for that run and host.
+pub fn decode_request(bytes: &[u8], offer: &RunOffer) -> Result<RunRequest, String> {
     let req: RunRequest =
-        serde_json::from_slice(&bytes).map_err(|e| format!("a bad request: {e}"))?;
+        serde_json::from_slice(bytes).map_err(|e| format!("a bad request: {e}"))?;
     if (req.run.as_str(), req.host.as_str()) != (offer.run.as_str(), offer.host.as_str()) {
         return Err(format!(
             "the request of run {} for {} came for run {} on {}",
