@@ -46,3 +46,50 @@ fn the_fixture_states_file_reads() {
     let (_dir, path) = file("states.bin", STATES);
     assert_eq!(read_states(&path), Ok(6));
 }
+
+/// host_messages: a run request whose node has a negative, huge or NaN-free
+/// but out-of-range timeout was accepted, and the host's run thread then
+/// panicked in `Duration::from_secs_f64` (found while writing the target,
+/// which now goes through the check); a node name with a `/` put its log
+/// outside the run's directory.
+#[test]
+fn run_requests_with_unusable_nodes_are_refused() {
+    use attsync::remote::host_run::decode_request;
+    use attsync::remote::wire::RunOffer;
+    let text = include_str!("../../fuzz/corpus/host_messages/run-request.json");
+    let offer = RunOffer {
+        run: "r1".into(),
+        host: "lab-a".into(),
+    };
+    assert!(decode_request(text.as_bytes(), &offer).is_ok());
+    let bad = [
+        (
+            "\"stage_timeout\": 10.0",
+            "\"stage_timeout\": -1.0",
+            "stage_timeout",
+        ),
+        (
+            "\"stage_timeout\": 10.0",
+            "\"stage_timeout\": 1e300",
+            "stage_timeout",
+        ),
+        (
+            "\"start_timeout\": 35.0",
+            "\"start_timeout\": 0.0",
+            "start_timeout",
+        ),
+        ("\"realtime\": null", "\"realtime\": -2.0", "realtime"),
+        (
+            "\"name\": \"agent-1\"",
+            "\"name\": \"../../agent-1\"",
+            "name",
+        ),
+    ];
+    for (from, to, field) in bad {
+        let e = decode_request(text.replacen(from, to, 1).as_bytes(), &offer).unwrap_err();
+        assert!(
+            e.contains(field) && e.starts_with("a bad request"),
+            "{to}: {e}"
+        );
+    }
+}
