@@ -32,7 +32,9 @@ fi
 
 cd fuzz
 echo "== building the fuzz targets"
+built=$(date +%s)
 cargo fuzz build "${FLAGS[@]}"
+echo "built in $(($(date +%s) - built)) s"
 if [ $# -gt 0 ]; then targets=("$@"); else mapfile -t targets < <(cargo fuzz list); fi
 
 scratch=$(mktemp -d)
