@@ -162,7 +162,7 @@ fn fetch(session: &zenoh::Session, offer: &RunOffer) -> Result<RunRequest, Strin
 
 /// The run request in `bytes` (put back together from its pieces) for the
 /// run `offer` offered: its JSON, for that run and host, each node's values
-/// usable ([`check_node`]).
+/// usable (`check_node`).
 pub fn decode_request(bytes: &[u8], offer: &RunOffer) -> Result<RunRequest, String> {
     let req: RunRequest =
         serde_json::from_slice(bytes).map_err(|e| format!("a bad request: {e}"))?;
