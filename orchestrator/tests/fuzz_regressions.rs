@@ -47,8 +47,8 @@ fn the_fixture_states_file_reads() {
     assert_eq!(read_states(&path), Ok(6));
 }
 
-/// host_messages: a run request whose node has a negative, huge or NaN-free
-/// but out-of-range timeout was accepted, and the host's run thread then
+/// host_messages: a run request whose node has a negative, zero or huge
+/// timeout (or real-time factor) was accepted, and the host's run thread then
 /// panicked in `Duration::from_secs_f64` (found while writing the target,
 /// which now goes through the check); a node name with a `/` put its log
 /// outside the run's directory.
