@@ -182,15 +182,42 @@ fn fetch(session: &zenoh::Session, offer: &RunOffer) -> Result<RunRequest, Strin
         .wait()
         .map_err(|e| format!("zenoh: {e}"))?;
     let bytes = pieces::collect(&replies).map_err(|e| format!("its request: {e}"))?;
+    decode_request(&bytes, offer)
+}
+
+/// The run request in `bytes` (put back together from its pieces) for the
+/// run `offer` offered: its JSON, for that run and host, each node's values
+/// usable (`check_node`).
+pub fn decode_request(bytes: &[u8], offer: &RunOffer) -> Result<RunRequest, String> {
     let req: RunRequest =
-        serde_json::from_slice(&bytes).map_err(|e| format!("a bad request: {e}"))?;
+        serde_json::from_slice(bytes).map_err(|e| format!("a bad request: {e}"))?;
     if (req.run.as_str(), req.host.as_str()) != (offer.run.as_str(), offer.host.as_str()) {
         return Err(format!(
             "the request of run {} for {} came for run {} on {}",
             offer.run, offer.host, req.run, req.host
         ));
     }
+    req.nodes.iter().try_for_each(check_node)?;
     Ok(req)
+}
+
+/// Why node `n` of a request cannot be started here: a name that is not a
+/// file name of its own (its log is `<name>.log` in the run's directory),
+/// or timeouts and a real-time factor outside what `attsync run` accepts
+/// (`Duration::from_secs_f64` panics on a negative or huge one).
+fn check_node(n: &super::wire::RemoteNode) -> Result<(), String> {
+    let bad = |e: &dyn std::fmt::Display| format!("a bad request: node {}: {e}", n.name);
+    let safe = |ch: char| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_';
+    if n.name.is_empty() || !n.name.chars().all(safe) {
+        return Err(bad(&"its name is not letters, digits, `-`, `_`"));
+    }
+    let c = &n.config;
+    crate::options::seconds("stage_timeout", c.stage_timeout).map_err(|e| bad(&e))?;
+    crate::options::seconds("start_timeout", c.start_timeout).map_err(|e| bad(&e))?;
+    match c.realtime {
+        Some(f) => crate::options::realtime(f).map_err(|e| bad(&e)),
+        None => Ok(()),
+    }
 }
 
 /// Serves run `req` until it ends; `reply` gets the answer to the run request.

@@ -39,8 +39,9 @@ fn frame(service: u32, m: &TelemetryMsg) -> Vec<u8> {
     out
 }
 
-/// The service id and message of a frame.
-fn unframe(b: &[u8]) -> Result<(u32, TelemetryMsg), String> {
+/// The service id and message of a frame (what the orchestrator's side
+/// decodes of each message on a host's telemetry link).
+pub fn unframe(b: &[u8]) -> Result<(u32, TelemetryMsg), String> {
     let (id, m) = b
         .split_at_checked(4)
         .ok_or("a telemetry frame of under 4 bytes")?;

@@ -23,7 +23,7 @@ use attitude::reference::LeaderState;
 use msgs::{from_rows, to_rows};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
-use std::io::{self, BufReader, BufWriter, Write};
+use std::io::{self, BufReader, BufWriter, Read, Write};
 use std::path::Path;
 
 /// File magic.
@@ -33,6 +33,16 @@ pub const VERSION: u32 = 1;
 
 fn config() -> impl bincode::config::Config {
     bincode::config::standard().with_fixed_int_encoding()
+}
+
+/// The most bytes a header may take: 64 MiB (a name and 16 million agent
+/// ids). A length field claiming more is refused before anything is
+/// allocated for it (bincode sizes a string's buffer from its length).
+pub const MAX_HEADER_BYTES: usize = 64 << 20;
+
+/// [`config`], refusing a header over [`MAX_HEADER_BYTES`].
+fn header_config() -> impl bincode::config::Config {
+    (bincode::config::standard().with_fixed_int_encoding()).with_limit::<MAX_HEADER_BYTES>()
 }
 
 /// The first value of the stream.
@@ -176,6 +186,8 @@ pub struct Records {
     file: std::path::PathBuf,
     r: BufReader<File>,
     left: u64,
+    /// One record's bytes, read whole before it is decoded.
+    buf: Vec<u8>,
 }
 
 /// Opens `file`, reads and checks its header and that its records are whole.
@@ -184,7 +196,7 @@ pub fn open(file: &Path) -> Result<Records, String> {
     let len = std::fs::metadata(file).map_err(|e| what(&e))?.len();
     let mut r = BufReader::new(File::open(file).map_err(|e| what(&e))?);
     let header: Header =
-        bincode::serde::decode_from_std_read(&mut r, config()).map_err(|e| what(&e))?;
+        bincode::serde::decode_from_std_read(&mut r, header_config()).map_err(|e| what(&e))?;
     if header.magic != MAGIC {
         return Err(what(&"not an attsync states file (bad magic)"));
     }
@@ -198,7 +210,7 @@ pub fn open(file: &Path) -> Result<Records, String> {
         .map_err(|e| what(&e))?
         .len() as u64;
     let record_len = 8 + 8 + 15 * 8 + header.agent_ids.len() as u64 * 27 * 8;
-    let body = len - header_len;
+    let body = len.saturating_sub(header_len);
     if body % record_len != 0 {
         return Err(what(&format!(
             "truncated: {body} bytes of records is not a multiple of the record size {record_len}"
@@ -209,10 +221,30 @@ pub fn open(file: &Path) -> Result<Records, String> {
         file: file.to_owned(),
         r,
         left: body / record_len,
+        buf: vec![0; record_len as usize],
     })
 }
 
 impl Records {
+    /// The next record: its bytes read whole (the size every record has),
+    /// then decoded; lengths inside that disagree with the header are refused.
+    fn record(&mut self) -> Result<Record, String> {
+        self.r
+            .read_exact(&mut self.buf)
+            .map_err(|e| e.to_string())?;
+        let (rec, used): (Record, usize) =
+            bincode::serde::decode_from_slice(&self.buf, config()).map_err(|e| e.to_string())?;
+        let agents = self.header.agent_ids.len();
+        if used != self.buf.len() || rec.agents.len() != agents {
+            return Err(format!(
+                "record of step {} holds {} agents, the header {agents}",
+                rec.step,
+                rec.agents.len()
+            ));
+        }
+        Ok(rec)
+    }
+
     /// How many records are left to read.
     #[must_use]
     pub fn remaining(&self) -> u64 {
@@ -228,8 +260,10 @@ impl Iterator for Records {
             return None;
         }
         self.left -= 1;
-        let rec = bincode::serde::decode_from_std_read(&mut self.r, config());
-        Some(rec.map_err(|e| format!("{}: {e}", self.file.display())))
+        Some(
+            self.record()
+                .map_err(|e| format!("{}: {e}", self.file.display())),
+        )
     }
 }
 
