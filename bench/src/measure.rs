@@ -116,7 +116,7 @@ pub fn attsync_with(
     let s = read_summary(&path)?;
     if !s.complete {
         return Err(BenchError::Incomplete(
-            s.incomplete_reason.unwrap_or_else(|| "?".into()),
+            (s.incomplete_reason).map_or_else(|| "?".into(), |f| f.to_string()),
         ));
     }
     let mut r = AttsyncRun {

@@ -9,6 +9,11 @@
 //! | 3 | the run diverged: a state left the envelope (`summary.json` `diverged`) |
 //! | 128 + N | interrupted by signal N: 130 SIGINT, 143 SIGTERM, 129 SIGHUP |
 //!
+//! Each error type decides its own code with an `exit_code()`
+//! ([`RunError::exit_code`], [`RunEnd::exit_code`], [`SweepError::exit_code`],
+//! [`crate::mc::McError::exit_code`], [`crate::failure::Failure::exit_code`]…);
+//! [`Error::exit_code`] only asks the one it wraps.
+//!
 //! `attsync verify` ([`crate::verify`]): 0 bit-identical, 1 different (or the
 //! re-run failed), 2 a missing or bad manifest or a run that cannot be verified.
 
@@ -93,16 +98,10 @@ impl Error {
     pub fn exit_code(&self) -> u8 {
         match self {
             Error::Scenario(_) | Error::Hosts(_) | Error::Options(_) | Error::Margin(_) => 2,
-            Error::Run(e) => run_code(e),
-            Error::RunEnd(RunEnd::Interrupted(signal)) => crate::interrupt::exit_code(*signal),
-            Error::RunEnd(RunEnd::Diverged(_)) => DIVERGED,
+            Error::Run(e) => e.exit_code(),
+            Error::RunEnd(e) => e.exit_code(),
             Error::Verify(e) => e.exit_code(),
-            Error::Sweep(e) => match e {
-                SweepError::Scenario(_) | SweepError::Options(_) => 2,
-                SweepError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
-                SweepError::Run { source, .. } => run_code(source),
-                _ => 1,
-            },
+            Error::Sweep(e) => e.exit_code(),
             Error::Mc(e) => e.exit_code(),
             Error::Host(e) => e.exit_code(),
             Error::Trust(e) => e.exit_code(),
@@ -129,13 +128,6 @@ impl Error {
 /// The exit code of a run that diverged.
 pub const DIVERGED: u8 = 3;
 
-fn run_code(e: &RunError) -> u8 {
-    match e {
-        RunError::Options(_) | RunError::Capacity(_) | RunError::Hosts(_) => 2,
-        _ => 1,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -149,10 +141,8 @@ mod tests {
         assert_eq!(Error::from(RunEnd::Interrupted(15)).exit_code(), 143);
         assert_eq!(Error::from(RunEnd::Interrupted(1)).exit_code(), 129);
         assert_eq!(Error::from(SweepError::Interrupted(2)).exit_code(), 130);
-        assert_eq!(
-            Error::from(RunEnd::Failed("node died".into())).exit_code(),
-            1
-        );
+        let died = crate::failure::Failure::Recorded("node died".into());
+        assert_eq!(Error::from(RunEnd::Failed(died)).exit_code(), 1);
         let capacity = crate::processes::capacity::CapacityError {
             engine: "processes",
             nodes: 5001,
@@ -163,7 +153,8 @@ mod tests {
         };
         assert_eq!(Error::from(RunError::from(capacity)).exit_code(), 2);
         assert_eq!(Error::NotConforming.exit_code(), 1);
-        let diverged = RunEnd::Diverged("diverged at t = 0.01 s: …".into());
+        let diverged = crate::failure::Failure::Diverged(Some("diverged at t = 0.01 s: …".into()));
+        let diverged = RunEnd::Diverged(diverged);
         assert_eq!(Error::from(diverged).exit_code(), 3);
         assert_eq!(Error::Export("bad file".into()).exit_code(), 1);
         let run = SweepError::Run {

@@ -34,6 +34,7 @@ pub mod conform;
 pub mod error;
 #[cfg(feature = "mcap")]
 pub mod export;
+pub mod failure;
 pub mod generate;
 pub mod hosts;
 pub mod interrupt;

@@ -2,6 +2,7 @@
 //! process engine ([`crate::processes::run`]) or the in-process engine
 //! ([`Outcome::in_process`]).
 
+use crate::failure::Failure;
 use attitude::engine::InProcess;
 use attitude::guard::Divergence;
 use attitude::link::LinkStats;
@@ -15,7 +16,7 @@ pub struct Outcome {
     /// Steps of the last complete snapshot.
     pub steps: u64,
     /// Why the run stopped early, if it did.
-    pub failure: Option<String>,
+    pub failure: Option<Failure>,
     /// The state that left the envelope, if the run diverged (then
     /// `failure` is set too).
     pub diverged: Option<Divergence>,
@@ -59,8 +60,8 @@ impl Outcome {
             peak_torques,
             steps,
             failure: (diverged.is_some() || interrupted).then(|| match diverged {
-                Some(_) => "diverged".to_string(),
-                None => "interrupted".to_string(),
+                Some(_) => Failure::Diverged(None),
+                None => Failure::Interrupted(None),
             }),
             diverged,
             links,

@@ -1,6 +1,7 @@
 //! `attsync run`: a loaded scenario through an engine into a results
 //! directory.
 
+use crate::failure::Failure;
 use crate::hosts::{Hosts, HostsError, Placement};
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
@@ -135,6 +136,18 @@ pub enum RunError {
         /// What went wrong.
         message: String,
     },
+}
+
+impl RunError {
+    /// The process exit code ([`crate::error`]'s table): 2 for options,
+    /// hosts or a capacity refused before anything started, else 1.
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            RunError::Options(_) | RunError::Capacity(_) | RunError::Hosts(_) => 2,
+            _ => 1,
+        }
+    }
 }
 
 impl From<CapacityError> for RunError {
@@ -316,15 +329,13 @@ fn drive(
     // stopped by the interrupt says "interrupted": say which signal.
     let outcome = driven.outcome;
     let failure = match &outcome.diverged {
-        Some(d) => Some(d.message(net, loaded.resolved.stiffness.as_ref())),
-        None => outcome
-            .failure
-            .map(|f| match f.strip_suffix("interrupted") {
-                Some(blame) if interrupt.is_set() => {
-                    blame.to_owned() + &interrupted_reason(interrupt)
-                }
-                _ => f,
-            }),
+        Some(d) => Some(Failure::Diverged(Some(
+            d.message(net, loaded.resolved.stiffness.as_ref()),
+        ))),
+        None => outcome.failure.map(|f| match interrupt.is_set() {
+            true => f.with_signal(interrupted_signal(interrupt)),
+            false => f,
+        }),
     };
     let outcome = Outcome { failure, ..outcome };
     Ok(Driven { outcome, ..driven })
@@ -587,7 +598,7 @@ fn manifest(
         stage_timeout: p.stage_timeout,
         realtime: p.realtime,
         complete: summary.complete,
-        incomplete_reason: summary.incomplete_reason.clone(),
+        incomplete_reason: (summary.incomplete_reason.as_ref()).map(ToString::to_string),
         diverged: summary.diverged.is_some(),
         ..Manifest::now(started)
     }
@@ -601,9 +612,9 @@ fn written(e: WriteError) -> RunError {
     }
 }
 
-/// `incomplete_reason` of an interrupted run.
-fn interrupted_reason(interrupt: &Interrupt) -> String {
-    crate::interrupt::reason(interrupt.signal().unwrap_or(signal_hook::consts::SIGINT))
+/// The signal named in `incomplete_reason` of an interrupted run.
+fn interrupted_signal(interrupt: &Interrupt) -> i32 {
+    interrupt.signal().unwrap_or(signal_hook::consts::SIGINT)
 }
 
 /// How a run that produced results ended, as an error if it did not
@@ -614,14 +625,14 @@ fn interrupted_reason(interrupt: &Interrupt) -> String {
 pub fn verdict(summary: &Summary, interrupt: &Interrupt) -> Result<(), RunEnd> {
     match (&summary.incomplete_reason, interrupt.signal()) {
         (None, _) => Ok(()),
-        (Some(reason), _) if summary.diverged.is_some() => Err(RunEnd::Diverged(reason.clone())),
+        (Some(f), _) if summary.diverged.is_some() => Err(RunEnd::Diverged(f.clone())),
         (Some(_), Some(signal)) => Err(RunEnd::Interrupted(signal)),
-        (Some(reason), None) => Err(RunEnd::Failed(reason.clone())),
+        (Some(f), None) => Err(RunEnd::Failed(f.clone())),
     }
 }
 
 /// A run that wrote its results but did not complete.
-#[derive(Debug, Clone, PartialEq, Eq, Error)]
+#[derive(Debug, Clone, PartialEq, Error)]
 pub enum RunEnd {
     /// A signal stopped it (the number).
     #[error("{}", crate::interrupt::reason(*.0))]
@@ -629,11 +640,24 @@ pub enum RunEnd {
     /// It failed: a node died, stalled or broke the protocol (the reason
     /// in `summary.json`).
     #[error("the run failed: {0}")]
-    Failed(String),
+    Failed(Failure),
     /// A state left the envelope (`summary.json` `diverged`; the message
     /// names the time, the node, the quantity and its value).
     #[error("the run {0}")]
-    Diverged(String),
+    Diverged(Failure),
+}
+
+impl RunEnd {
+    /// The process exit code ([`crate::error`]'s table): 128 + N for
+    /// signal N, 3 diverged, 1 failed.
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            RunEnd::Interrupted(signal) => crate::interrupt::exit_code(*signal),
+            RunEnd::Diverged(_) => crate::error::DIVERGED,
+            RunEnd::Failed(f) => f.exit_code(),
+        }
+    }
 }
 
 /// Options that the scenario cannot run with.
@@ -767,7 +791,10 @@ mod tests {
         let s = run(&loaded, &options(out.clone()), &interrupt).expect("results");
         assert!(!s.complete);
         assert_eq!(
-            s.incomplete_reason.as_deref(),
+            s.incomplete_reason
+                .as_ref()
+                .map(ToString::to_string)
+                .as_deref(),
             Some("interrupted by SIGHUP")
         );
         assert_eq!(verdict(&s, &interrupt), Err(RunEnd::Interrupted(1)));

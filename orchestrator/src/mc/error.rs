@@ -66,7 +66,7 @@ impl McError {
         match self {
             McError::Scenario(_) | McError::Options(_) | McError::Capacity(_) => 2,
             McError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
-            McError::Run(RunError::Options(_) | RunError::Capacity(_)) => 2,
+            McError::Run(e) => e.exit_code(),
             _ => 1,
         }
     }

@@ -2,9 +2,10 @@
 //! ([`Session::ended_early`]), and, when nodes gave up waiting, the node they
 //! waited for ([`Collector::blame`]), put first in the failure's text.
 
+use super::Session;
 use super::collect::Collector;
 use super::supervise::{describe, tail};
-use super::{Failure, Session};
+use crate::failure::Failure;
 use std::time::{Duration, Instant};
 
 impl Session<'_> {
@@ -15,13 +16,12 @@ impl Session<'_> {
             let clean = matches!(&e.status, Ok(s) if s.success());
             let slot = &self.nodes.slots[e.index];
             if !(slot.done && clean) {
-                return Some(format!(
-                    "{} ended during the run ({}); last lines of its log (logs/{}.log in the results directory):\n{}",
-                    slot.label,
-                    describe(&e.status),
-                    slot.name,
-                    tail(&self.log_of(e.index), 10)
-                ));
+                return Some(Failure::NodeEnded {
+                    label: slot.label.clone(),
+                    status: describe(&e.status),
+                    log: slot.name.clone(),
+                    tail: tail(&self.log_of(e.index), 10),
+                });
             }
         }
         None
@@ -38,10 +38,12 @@ impl Session<'_> {
                 continue;
             };
             if !(slot.done && e.clean) {
-                return Ok(Some(format!(
-                    "{} ended during the run ({}); last lines of its log (logs/{}.log in the results directory):\n{}",
-                    slot.label, e.status, slot.name, e.tail
-                )));
+                return Ok(Some(Failure::NodeEnded {
+                    label: slot.label.clone(),
+                    status: e.status,
+                    log: slot.name.clone(),
+                    tail: e.tail,
+                }));
             }
         }
         Ok(None)
@@ -62,7 +64,10 @@ impl Session<'_> {
             }
         }
         match self.nodes.blame() {
-            Some(b) => format!("{b}\n{failure}"),
+            Some(culprits) => Failure::Blamed {
+                culprits,
+                failure: Box::new(failure),
+            },
             None => failure,
         }
     }

@@ -3,7 +3,8 @@
 //! snapshots the in-process engine produces ([`Session::collect`]).
 
 use super::startup::POLL;
-use super::{Failure, Ports, Session};
+use super::{Ports, Session};
+use crate::failure::Failure;
 use crate::outcome::Outcome;
 use attitude::engine::Snapshot;
 use attitude::guard::{self, Divergence, Envelope, Violation};
@@ -107,7 +108,10 @@ impl Collector {
     pub(crate) fn drain(&mut self, ports: &Ports) -> Result<bool, Failure> {
         let mut any = false;
         for i in 0..self.slots.len() {
-            while let Some(m) = ports.receive(i).map_err(|e| e.to_string())? {
+            while let Some(m) = ports
+                .receive(i)
+                .map_err(|e| Failure::Telemetry(e.to_string()))?
+            {
                 any = true;
                 self.accept(i, &m)?;
             }
@@ -120,14 +124,14 @@ impl Collector {
     pub(crate) fn accept(&mut self, i: usize, m: &TelemetryMsg) -> Result<(), Failure> {
         let slot = &self.slots[i];
         if m.sender != slot.id {
-            return Err(format!(
-                "{} broke the protocol: its telemetry claims to come from node {}",
-                slot.label, m.sender
-            ));
+            return Err(Failure::BrokeProtocol {
+                node: slot.label.clone(),
+                how: format!("its telemetry claims to come from node {}", m.sender),
+            });
         }
         let t = m
             .decode()
-            .map_err(|e| format!("node {}'s telemetry: {e}", m.sender))?;
+            .map_err(|e| Failure::Telemetry(format!("node {}'s telemetry: {e}", m.sender)))?;
         self.take(i, t)
     }
 
@@ -233,10 +237,10 @@ impl Collector {
 
     /// The failure of node index `i`, which sent telemetry `what`.
     fn sent_garbage(&self, i: usize, what: &str) -> Failure {
-        format!(
-            "{} broke the protocol: it sent telemetry {what}",
-            self.slots[i].label
-        )
+        Failure::BrokeProtocol {
+            node: self.slots[i].label.clone(),
+            how: format!("it sent telemetry {what}"),
+        }
     }
 
     /// The run's divergence: the earliest step, then the first node (the
@@ -267,10 +271,10 @@ impl Collector {
             return Ok(None);
         }
         if let Some(s) = self.slots.iter().find(|s| s.pending[0].0 != step) {
-            return Err(format!(
+            return Err(Failure::Telemetry(format!(
                 "telemetry out of step: {} at step {}, leader at {step}",
                 s.name, s.pending[0].0
-            ));
+            )));
         }
         let mut samples = (self.slots.iter_mut()).map(|s| {
             let sample = s.pending.pop_front().expect("non-empty").1;
@@ -280,12 +284,16 @@ impl Collector {
             (s.name.as_str(), sample)
         });
         let Some((_, Sampled::Leader(leader))) = samples.next() else {
-            return Err("the leader sent an agent's sample".into());
+            return Err(Failure::Telemetry(
+                "the leader sent an agent's sample".into(),
+            ));
         };
         let agents = samples
             .map(|(name, s)| match s {
                 Sampled::Agent(a, _) => Ok(a),
-                Sampled::Leader(_) => Err(format!("{name} sent the leader's sample")),
+                Sampled::Leader(_) => Err(Failure::Telemetry(format!(
+                    "{name} sent the leader's sample"
+                ))),
             })
             .collect::<Result<_, _>>()?;
         Ok(Some((step, leader, agents)))
@@ -345,7 +353,7 @@ impl Session<'_> {
                     agents: &agents,
                 };
                 if !on_sample(&snap) {
-                    return Err("stopped by the results writer".into());
+                    return Err(Failure::WriterStopped);
                 }
             }
             if !self.nodes.diverged.is_empty() {
@@ -355,7 +363,7 @@ impl Session<'_> {
                 // is the divergence's (`crate::run`).
                 let since = *diverging.get_or_insert_with(Instant::now);
                 if last_progress.elapsed() >= QUIET || since.elapsed() >= SETTLE {
-                    return Err("diverged".into());
+                    return Err(Failure::Diverged(None));
                 }
                 continue;
             }
@@ -364,10 +372,9 @@ impl Session<'_> {
             }
             self.still_running()?;
             if last_progress.elapsed() > stall {
-                return Err(format!(
-                    "no telemetry for {:.0} s: the run is stalled",
-                    stall.as_secs_f64()
-                ));
+                return Err(Failure::Stalled {
+                    seconds: stall.as_secs_f64(),
+                });
             }
         }
     }
@@ -394,7 +401,7 @@ mod tests {
     fn telemetry_from_a_false_sender_fails_naming_the_node() {
         let mut c = two_nodes();
         let m = TelemetryMsg::encode(7, &Telemetry::Ready);
-        let e = c.accept(1, &m).expect_err("a false sender");
+        let e = c.accept(1, &m).expect_err("a false sender").to_string();
         assert!(
             e.starts_with("agent-3 (plug-in `x`) broke the protocol"),
             "{e}"
@@ -416,7 +423,7 @@ mod tests {
         let mut c = two_nodes();
         let mut m = TelemetryMsg::encode(3, &Telemetry::Ready);
         m.kind = 99;
-        let e = c.accept(1, &m).expect_err("an unknown kind");
+        let e = c.accept(1, &m).expect_err("an unknown kind").to_string();
         assert!(e.starts_with("node 3's telemetry"), "{e}");
     }
 
@@ -455,7 +462,10 @@ mod tests {
     #[test]
     fn a_sample_whose_attitude_is_not_a_rotation_fails_naming_the_node() {
         let mut c = two_nodes();
-        let e = c.accept(1, &sample(0, 1.0, 2.0)).expect_err("2·I");
+        let e = c
+            .accept(1, &sample(0, 1.0, 2.0))
+            .expect_err("2·I")
+            .to_string();
         assert_eq!(
             e,
             "agent-3 (plug-in `x`) broke the protocol: it sent telemetry whose attitude r is not a rotation"

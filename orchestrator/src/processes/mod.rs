@@ -100,8 +100,8 @@ pub enum ProcessError {
     #[error("iceoryx2: {0}")]
     Open(#[from] OpenError),
     /// A host of the run cannot be reached or used.
-    #[error("{0}")]
-    Remote(String),
+    #[error(transparent)]
+    Remote(#[from] crate::remote::RemoteError),
     /// A file could not be written.
     #[error("{path}: {source}")]
     Io {
@@ -117,9 +117,6 @@ pub(crate) fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> ProcessError 
     let path = path.to_owned();
     move |source| ProcessError::Io { path, source }
 }
-
-/// Why a run stopped early (the text the results report).
-pub(crate) type Failure = String;
 
 /// A run in progress: what every phase works on.
 struct Session<'a> {

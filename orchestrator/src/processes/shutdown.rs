@@ -2,8 +2,9 @@
 //! (a node that does not exit cleanly fails the run); after a failure, every
 //! node killed.
 
+use super::Session;
 use super::supervise::describe;
-use super::{Failure, Session};
+use crate::failure::Failure;
 use msgs::{ControlCommand, ControlMsg};
 use std::time::Duration;
 
@@ -43,6 +44,6 @@ impl Session<'_> {
                 bad.push(format!("{label}: {}", e.status));
             }
         }
-        (!bad.is_empty()).then(|| format!("nodes failed at shutdown: {}", bad.join("; ")))
+        (!bad.is_empty()).then_some(Failure::Shutdown(bad))
     }
 }

@@ -6,7 +6,8 @@ use super::collect::{Collector, NodeSlot};
 use super::configs::{node_configs, node_id, node_label, node_name, plugin_of};
 use super::namespace::{self, Namespace};
 use super::supervise::{Launch, Supervisor, find_binaries};
-use super::{Failure, ProcessError, ProcessOptions, Session, io_at};
+use super::{ProcessError, ProcessOptions, Session, io_at};
+use crate::failure::Failure;
 use attitude::network::Network;
 use iceoryx2::service::port_factory::PortFactory;
 use msgs::{ControlCommand, ControlMsg, Limits};
@@ -39,8 +40,7 @@ impl<'a> Session<'a> {
         let sup = Supervisor::new().map_err(io_at(Path::new("tokio runtime")))?;
         let remote = (opts.hosts.as_ref())
             .map(|plan| crate::remote::Remote::connect(plan, ports.run()))
-            .transpose()
-            .map_err(ProcessError::Remote)?;
+            .transpose()?;
         let slots = (0..n_nodes)
             .map(|i| {
                 let mut label = node_label(net, &opts.plugins, i);
@@ -136,18 +136,11 @@ impl<'a> Session<'a> {
                 .collect::<Vec<_>>()
                 .join(", ")
         };
-        let t = self.opts.start_timeout;
-        match (silent.is_empty(), waiting.is_empty()) {
-            (true, _) => format!(
-                "start-up timed out after {t} s: not ready: {}",
-                labels(&waiting)
-            ),
-            (false, true) => format!(
-                "start-up timed out after {t} s: never connected (opened no ports): {}",
-                labels(&silent)
-            ),
+        let nodes = match (silent.is_empty(), waiting.is_empty()) {
+            (true, _) => format!("not ready: {}", labels(&waiting)),
+            (false, true) => format!("never connected (opened no ports): {}", labels(&silent)),
             (false, false) => format!(
-                "start-up timed out after {t} s: never connected (opened no ports): {}\n\
+                "never connected (opened no ports): {}\n\
                  (connected, but left waiting for them: {})",
                 labels(&silent),
                 (waiting.iter())
@@ -155,6 +148,10 @@ impl<'a> Session<'a> {
                     .collect::<Vec<_>>()
                     .join(", ")
             ),
+        };
+        Failure::StartupTimedOut {
+            after: self.opts.start_timeout,
+            nodes,
         }
     }
 
@@ -168,9 +165,7 @@ impl<'a> Session<'a> {
         if let Some(r) = &self.remote {
             r.control(msg)?;
         }
-        (self.ports)
-            .send(msg)
-            .map_err(|_| "cannot send Start".to_string())
+        (self.ports).send(msg).map_err(|_| Failure::StartNotSent)
     }
 
     /// Hands each host its nodes and starts the bridges of a run placed
@@ -200,7 +195,7 @@ impl<'a> Session<'a> {
                 });
             (node_name(net, i), plugin)
         };
-        remote.start(&ns, &configs, &node)
+        Ok(remote.start(&ns, &configs, &node)?)
     }
 
     /// Fails if a node has ended before it was done, or on an interrupt.
@@ -212,7 +207,7 @@ impl<'a> Session<'a> {
             return Err(f);
         }
         if self.interrupt.load(Ordering::Relaxed) {
-            return Err("interrupted".into());
+            return Err(Failure::Interrupted(None));
         }
         Ok(())
     }

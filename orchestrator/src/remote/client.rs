@@ -11,6 +11,7 @@ use super::keys;
 use super::local::{LocalNs, Shared};
 use super::pieces;
 use super::plan::{Plan, links};
+pub use super::remote_error::RemoteError;
 use super::telemetry::{self, End, TelemetryThread};
 use super::wire::{
     Answer, EndReply, EndRequest, HostEvent, NodeEnd, RemoteNode, RunOffer, RunRequest,
@@ -77,16 +78,17 @@ impl std::fmt::Debug for Remote {
     }
 }
 
-fn zerr(e: impl std::fmt::Display) -> String {
-    format!("zenoh: {e}")
+fn zerr(e: impl std::fmt::Display) -> RemoteError {
+    RemoteError::Zenoh(e.to_string())
 }
 
 impl Remote {
     /// Dials every host of `plan` for run `run` and waits until each answers
     /// a ping (an error names the first host that does not).
-    pub fn connect(plan: &Plan, run: &str) -> Result<Self, String> {
+    pub fn connect(plan: &Plan, run: &str) -> Result<Self, RemoteError> {
         let endpoints: Vec<String> = plan.hosts.iter().map(|h| h.endpoint.clone()).collect();
-        let session = zconfig::open(&[], &endpoints, &plan.security).map_err(|e| e.to_string())?;
+        let session = zconfig::open(&[], &endpoints, &plan.security)
+            .map_err(|e| RemoteError::Session(e.to_string()))?;
         let token = (session.liveliness())
             .declare_token(keys::orchestrator_alive(run))
             .wait()
@@ -136,7 +138,7 @@ impl Remote {
     }
 
     /// Waits up to [`REACH_TIMEOUT`] for host `name`'s answer to a ping.
-    fn ping(&self, name: &str, endpoint: &str) -> Result<(), String> {
+    fn ping(&self, name: &str, endpoint: &str) -> Result<(), RemoteError> {
         let until = Instant::now() + REACH_TIMEOUT;
         while Instant::now() < until {
             let replies = (self.session.get(keys::ping(name)))
@@ -149,11 +151,11 @@ impl Remote {
             }
             std::thread::sleep(Duration::from_millis(100));
         }
-        Err(format!(
-            "host {name} ({endpoint}) is unreachable: no answer within {} s; is \
-             `attsync host --name {name} --listen {endpoint}` running there, and its port open?",
-            REACH_TIMEOUT.as_secs()
-        ))
+        Err(RemoteError::Unreachable {
+            name: name.into(),
+            endpoint: endpoint.into(),
+            seconds: REACH_TIMEOUT.as_secs(),
+        })
     }
 
     /// Whether node `id` runs on a host.
@@ -178,7 +180,7 @@ impl Remote {
         ns: &LocalNs,
         configs: &[NodeConfig],
         node: &dyn Fn(u32) -> (String, Option<super::wire::PluginCommand>),
-    ) -> Result<(), String> {
+    ) -> Result<(), RemoteError> {
         let links = links(configs, &self.plan);
         let (s, run) = (&self.session, self.run.as_str());
         self.bridges = Some(Bridges::start(
@@ -245,14 +247,17 @@ impl Remote {
                 }
                 Err(e) => Err(e.to_string()),
             };
-            answer.map_err(|e| format!("host {name} could not start its nodes: {e}"))?;
+            answer.map_err(|why| RemoteError::NotStarted {
+                host: name.clone(),
+                why,
+            })?;
             self.started.push(name);
         }
         Ok(())
     }
 
     /// Relays control message `m` to every host.
-    pub fn control(&self, m: ControlMsg) -> Result<(), String> {
+    pub fn control(&self, m: ControlMsg) -> Result<(), RemoteError> {
         (self.session.put(keys::control(&self.run), m.to_bytes()))
             .congestion_control(zenoh::qos::CongestionControl::Block)
             .express(true)
@@ -262,19 +267,16 @@ impl Remote {
 
     /// A lost host, a host's failure, or a bridge's: the run cannot go on.
     /// `Ok` carries the node exits the hosts reported since the last call.
-    pub fn check(&self) -> Result<Vec<RemoteExit>, String> {
+    pub fn check(&self) -> Result<Vec<RemoteExit>, RemoteError> {
         if let Some(h) = self.lost_host() {
             let nodes: Vec<String> = (self.plan.hosts.iter())
                 .find(|p| p.name == h)
                 .map(|p| p.nodes.iter().map(|&id| node_name(id)).collect())
                 .unwrap_or_default();
-            return Err(format!(
-                "host {h} was lost (its daemon or the connection to it is gone); its nodes: {}",
-                nodes.join(", ")
-            ));
+            return Err(RemoteError::HostLost { host: h, nodes });
         }
         if let Some(f) = self.shared.failure() {
-            return Err(f);
+            return Err(RemoteError::Bridge(f));
         }
         let mut exits = Vec::new();
         while let Ok(Some(s)) = self.events.try_recv() {
@@ -298,8 +300,11 @@ impl Remote {
                     clean,
                     tail,
                 }),
-                Ok(HostEvent::Failed(f)) => return Err(format!("host {host}: {f}")),
-                Err(e) => return Err(format!("host {host} sent a bad event: {e}")),
+                Ok(HostEvent::Failed(why)) => return Err(RemoteError::HostFailed { host, why }),
+                Err(e) => {
+                    let why = e.to_string();
+                    return Err(RemoteError::BadEvent { host, why });
+                }
             }
         }
         Ok(exits)

@@ -14,7 +14,7 @@
 //! - [`local`]: a run's namespace on one side, the stop flag and first failure.
 //! - [`bridge`], [`telemetry`]: the threads that carry states and telemetry.
 //! - [`plan`]: which host runs which node; the state links between sides.
-//! - [`client`]: the orchestrator's side ([`Remote`]).
+//! - [`client`]: the orchestrator's side ([`Remote`]; its errors [`RemoteError`]).
 //! - [`daemon`], [`host_run`]: the host's side.
 
 pub mod bridge;
@@ -26,12 +26,14 @@ pub mod link;
 pub mod local;
 pub mod pieces;
 pub mod plan;
+pub mod remote_error;
 pub mod telemetry;
 pub mod wire;
 pub mod zconfig;
 
 pub use client::Remote;
 pub use plan::{Plan, PlannedHost};
+pub use remote_error::RemoteError;
 
 use serde::{Deserialize, Serialize};
 use std::fmt;

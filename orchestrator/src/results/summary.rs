@@ -1,5 +1,6 @@
 //! `summary.json` and the table printed at the end of a run.
 
+use crate::failure::Failure;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
@@ -133,8 +134,8 @@ pub struct Summary {
     pub law: attitude::control::ControlLaw,
     /// Whether the run reached its horizon.
     pub complete: bool,
-    /// Why not, if not.
-    pub incomplete_reason: Option<String>,
+    /// Why not, if not (its text; read back: [`Failure::Recorded`]).
+    pub incomplete_reason: Option<Failure>,
     /// The state that left the envelope, if the run diverged.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub diverged: Option<Diverged>,
@@ -361,7 +362,7 @@ impl Summary {
             } else {
                 format!(
                     " INCOMPLETE: {}",
-                    self.incomplete_reason.as_deref().unwrap_or("?")
+                    (self.incomplete_reason.as_ref()).map_or("?".into(), ToString::to_string)
                 )
             }
         );

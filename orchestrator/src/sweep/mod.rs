@@ -130,6 +130,20 @@ pub enum SweepError {
     Plot(String),
 }
 
+impl SweepError {
+    /// The process exit code ([`crate::error`]'s table): 2 for an invalid
+    /// input, 128 + N interrupted, a run's own code, else 1.
+    #[must_use]
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            SweepError::Scenario(_) | SweepError::Options(_) => 2,
+            SweepError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
+            SweepError::Run { source, .. } => source.exit_code(),
+            _ => 1,
+        }
+    }
+}
+
 fn io_at(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
     move |source| SweepError::Io {
         path: path.to_owned(),

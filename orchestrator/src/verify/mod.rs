@@ -91,7 +91,7 @@ pub fn verify(
         return Err(VerifyError::Interrupted(signal));
     }
     if let (false, None) = (summary.complete, &summary.diverged) {
-        let reason = summary.incomplete_reason.unwrap_or_default();
+        let reason = (summary.incomplete_reason).map_or_else(String::new, |f| f.to_string());
         return Err(VerifyError::Rerun(reason));
     }
     Ok(Report {

@@ -127,7 +127,7 @@ pub fn run_info(s: &Summary) -> RunInfo {
         scenario: s.scenario.clone(),
         engine: s.engine.clone(),
         complete: s.complete,
-        incomplete_reason: s.incomplete_reason.clone(),
+        incomplete_reason: (s.incomplete_reason.as_ref()).map(ToString::to_string),
         realtime: s.realtime,
     }
 }
