@@ -19,7 +19,7 @@ fn file(name: &str, bytes: &[u8]) -> (tempfile::TempDir, std::path::PathBuf) {
 
 /// A states file's every reader: `read` (export --csv), `open` and its records
 /// (view, verify, export --mcap).
-fn read_states(path: &Path) -> Result<usize, String> {
+fn read_states(path: &Path) -> Result<usize, states::StatesError> {
     let (_, records) = states::read(path)?;
     let mut n = 0;
     for r in states::open(path)? {
@@ -36,7 +36,7 @@ fn read_states(path: &Path) -> Result<usize, String> {
 fn states_header_with_a_huge_name_length_is_refused() {
     let bytes = include_bytes!("../../fuzz/corpus/states_file/regression-huge-name-length.bin");
     let (_dir, path) = file("states.bin", bytes);
-    let e = read_states(&path).unwrap_err();
+    let e = read_states(&path).unwrap_err().to_string();
     assert!(e.contains("states.bin"), "{e}");
 }
 
@@ -44,7 +44,7 @@ fn states_header_with_a_huge_name_length_is_refused() {
 #[test]
 fn the_fixture_states_file_reads() {
     let (_dir, path) = file("states.bin", STATES);
-    assert_eq!(read_states(&path), Ok(6));
+    assert_eq!(read_states(&path).map_err(|e| e.to_string()), Ok(6));
 }
 
 /// host_messages: a run request whose node has a negative, zero or huge
@@ -86,7 +86,8 @@ fn run_requests_with_unusable_nodes_are_refused() {
         ),
     ];
     for (from, to, field) in bad {
-        let e = decode_request(text.replacen(from, to, 1).as_bytes(), &offer).unwrap_err();
+        let e = (decode_request(text.replacen(from, to, 1).as_bytes(), &offer).unwrap_err())
+            .to_string();
         assert!(
             e.contains(field) && e.starts_with("a bad request"),
             "{to}: {e}"

@@ -12,7 +12,7 @@ use std::process::ExitStatus;
 use std::time::Duration;
 
 /// How a candidate ended (or why it could not start).
-pub(super) type Status = Result<ExitStatus, String>;
+pub(super) type Status = Result<ExitStatus, std::io::Error>;
 
 /// Longest wait for the candidate to exit (after Stop, or with a bad config).
 pub(super) const EXIT_TIMEOUT: Duration = Duration::from_secs(10);
@@ -73,7 +73,8 @@ impl Candidate {
             let exit = sup.next_exit(Duration::from_secs(5));
             return Err(ConformError::Start {
                 command: opts.command.join(" "),
-                reason: exit.and_then(|e| e.status.err()).unwrap_or_default(),
+                reason: (exit.and_then(|e| e.status.err()))
+                    .map_or_else(String::new, |e| e.to_string()),
             });
         };
         Ok(Self { sup, pid })

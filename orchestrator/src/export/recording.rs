@@ -39,8 +39,8 @@ pub fn errors_topic(id: u32) -> String {
 #[derive(Debug, thiserror::Error)]
 pub enum McapExportError {
     /// `states.bin` could not be read (the message names the file and why).
-    #[error("{0}")]
-    States(String),
+    #[error(transparent)]
+    States(#[from] crate::results::states::StatesError),
     /// The output file could not be created or written (the OS error).
     #[error("writing {}: {source}", path.display())]
     Io {

@@ -91,8 +91,8 @@ impl Default for ProcessOptions {
 #[derive(Debug, Error)]
 pub enum ProcessError {
     /// A node binary is missing.
-    #[error("{0}")]
-    MissingBinary(String),
+    #[error(transparent)]
+    MissingBinary(#[from] supervise::MissingBinaries),
     /// An iceoryx2 call failed.
     #[error(transparent)]
     Iceoryx(#[from] IoxError),

@@ -30,7 +30,7 @@ impl<'a> Session<'a> {
         logs: &'a Path,
         interrupt: &'a AtomicBool,
     ) -> Result<Self, ProcessError> {
-        let binaries = find_binaries().map_err(ProcessError::MissingBinary)?;
+        let binaries = find_binaries()?;
         std::fs::create_dir_all(logs).map_err(io_at(logs))?;
         let ns = Namespace::create().map_err(io_at(&namespace::base_dir()))?;
         let n_nodes = net.agents.len() + 1;

@@ -32,14 +32,14 @@ pub struct Exit {
     /// Index of the node (0 = leader, then agents in network order).
     pub index: usize,
     /// How it ended (or why it could not start).
-    pub status: Result<ExitStatus, String>,
+    pub status: Result<ExitStatus, std::io::Error>,
     /// Its process group (the id of the process), if it started.
     pub pgid: Option<u32>,
 }
 
 /// Describes an exit status: `exit code 1`, `killed by signal 9 (SIGKILL)`.
 #[must_use]
-pub fn describe(status: &Result<ExitStatus, String>) -> String {
+pub fn describe(status: &Result<ExitStatus, std::io::Error>) -> String {
     match status {
         Err(e) => format!("could not start: {e}"),
         Ok(s) => match (s.code(), s.signal()) {
@@ -171,7 +171,7 @@ impl Supervisor {
                 Err(e) => {
                     let _ = tx.send(Exit {
                         index,
-                        status: Err(e.to_string()),
+                        status: Err(e),
                         pgid: None,
                     });
                     return;
@@ -197,7 +197,7 @@ impl Supervisor {
             let _ = tokio::time::timeout(Duration::from_secs(2), copy).await;
             let _ = tx.send(Exit {
                 index,
-                status: status.map_err(|e| e.to_string()),
+                status,
                 pgid,
             });
         });
@@ -343,7 +343,10 @@ pub use super::node_log::tail;
 
 /// Paths of the node binaries, found beside the running executable (or in
 /// `ATTSYNC_BIN_DIR`).
-pub fn find_binaries() -> Result<(PathBuf, PathBuf), String> {
+///
+/// # Errors
+/// [`MissingBinaries`] when no directory holds both.
+pub fn find_binaries() -> Result<(PathBuf, PathBuf), MissingBinaries> {
     let mut dirs = Vec::new();
     if let Some(d) = std::env::var_os("ATTSYNC_BIN_DIR") {
         dirs.push(PathBuf::from(d));
@@ -363,11 +366,16 @@ pub fn find_binaries() -> Result<(PathBuf, PathBuf), String> {
             return Ok((a, l));
         }
     }
-    Err(format!(
-        "the node binaries attsync-agent and attsync-leader are not beside attsync (looked in {}); build them with `cargo build --release --workspace` (or set ATTSYNC_BIN_DIR)",
-        dirs.iter()
-            .map(|d| d.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    ))
+    Err(MissingBinaries { looked_in: dirs })
+}
+
+/// The node binaries are not where [`find_binaries`] looks.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the node binaries attsync-agent and attsync-leader are not beside attsync (looked in {}); build them with `cargo build --release --workspace` (or set ATTSYNC_BIN_DIR)",
+    looked_in.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
+)]
+pub struct MissingBinaries {
+    /// The directories looked in.
+    pub looked_in: Vec<PathBuf>,
 }

@@ -239,18 +239,16 @@ impl Remote {
         }
         for (name, replies, _served) in pending {
             let answer: Answer = match pieces::collect(&replies) {
-                Ok(b) => {
-                    serde_json::from_slice(&b).unwrap_or_else(|e| Err(format!("a bad answer: {e}")))
-                }
+                Ok(b) => serde_json::from_slice(&b)
+                    .unwrap_or_else(|e| Answer::Err(format!("a bad answer: {e}"))),
                 Err(pieces::CollectError::NoAnswer) => {
-                    Err(format!("no answer within {} s", ANSWER_TIMEOUT.as_secs()))
+                    Answer::Err(format!("no answer within {} s", ANSWER_TIMEOUT.as_secs()))
                 }
-                Err(e) => Err(e.to_string()),
+                Err(e) => Answer::Err(e.to_string()),
             };
-            answer.map_err(|why| RemoteError::NotStarted {
-                host: name.clone(),
-                why,
-            })?;
+            if let Answer::Err(why) = answer {
+                return Err(RemoteError::NotStarted { host: name, why });
+            }
             self.started.push(name);
         }
         Ok(())

@@ -8,7 +8,7 @@
 
 use super::host_run::{self, Command};
 use super::keys;
-use super::wire::{EndRequest, RunOffer};
+use super::wire::{Answer, EndRequest, RunOffer};
 use super::zconfig::{self, ConfigError};
 use crate::trust::Security;
 use crate::trust::allow::Allowlist;
@@ -62,22 +62,25 @@ impl HostError {
 }
 
 /// Checks `name`: a Zenoh key chunk of letters, digits, `-` and `_`.
-pub fn check_name(flag: &str, name: &str) -> Result<(), String> {
+///
+/// # Errors
+/// [`HostError::Invalid`] naming `flag`.
+pub fn check_name(flag: &str, name: &str) -> Result<(), HostError> {
     let ok = !name.is_empty()
         && (name.chars()).all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
     if ok {
         Ok(())
     } else {
-        Err(format!(
+        Err(HostError::Invalid(format!(
             "{flag}: `{name}` is not a host name (letters, digits, `-`, `_`)"
-        ))
+        )))
     }
 }
 
 impl HostOptions {
     /// Checks every option, naming the first bad one.
     pub fn check(&self) -> Result<(), HostError> {
-        check_name("--name", &self.name).map_err(HostError::Invalid)?;
+        check_name("--name", &self.name)?;
         if self.listen.is_empty() {
             return Err(HostError::Invalid("--listen: at least one endpoint".into()));
         }
@@ -147,12 +150,17 @@ pub fn serve(opts: &HostOptions, stop: &AtomicBool) -> Result<(), HostError> {
 }
 
 /// The payload of `q` as `T`, or the reason it is not one.
-fn payload<T: serde::de::DeserializeOwned>(q: &Query) -> Result<T, String> {
+fn payload<T: serde::de::DeserializeOwned>(q: &Query) -> Result<T, serde_json::Error> {
     let b = q
         .payload()
         .map(|p| p.to_bytes().into_owned())
         .unwrap_or_default();
-    serde_json::from_slice(&b).map_err(|e| format!("a bad request: {e}"))
+    serde_json::from_slice(&b)
+}
+
+/// Refuses query `q`, saying `why`.
+fn refuse(q: &Query, why: String) {
+    host_run::answer(q, &Answer::Err(why));
 }
 
 /// Starts the run offered by `q` on its own thread, which fetches the
@@ -166,15 +174,13 @@ fn accept(
 ) {
     let req: RunOffer = match payload(&q) {
         Ok(r) => r,
-        Err(e) => return host_run::answer(&q, &Err(e)),
+        Err(e) => return refuse(&q, format!("a bad request: {e}")),
     };
     if req.host != name {
-        let e = format!("this is host {name}, not {}", req.host);
-        return host_run::answer(&q, &Err(e));
+        return refuse(&q, format!("this is host {name}, not {}", req.host));
     }
     if runs.contains_key(&req.run) {
-        let e = format!("run {} is already here", req.run);
-        return host_run::answer(&q, &Err(e));
+        return refuse(&q, format!("run {} is already here", req.run));
     }
     let (tx, rx) = mpsc::channel();
     let s = session.clone();
@@ -188,14 +194,14 @@ fn accept(
 fn route_end(q: Query, runs: &HashMap<String, (Sender<Command>, JoinHandle<()>)>) {
     let req: EndRequest = match payload(&q) {
         Ok(r) => r,
-        Err(e) => return host_run::answer(&q, &Err(e)),
+        Err(e) => return refuse(&q, format!("a bad request: {e}")),
     };
     match runs.get(&req.run) {
         Some((tx, _)) => {
             if let Err(mpsc::SendError(Command::End(_, q))) = tx.send(Command::End(req, q)) {
-                host_run::answer(&q, &Err("the run has ended".into()));
+                refuse(&q, "the run has ended".into());
             }
         }
-        None => host_run::answer(&q, &Err(format!("no run {} here", req.run))),
+        None => refuse(&q, format!("no run {} here", req.run)),
     }
 }

@@ -7,11 +7,12 @@
 
 use super::Side;
 use super::bridge::Bridges;
+pub use super::host_run_error::{RequestError, StartError};
 use super::keys;
 use super::local::{LocalNs, Shared};
 use super::pieces;
 use super::telemetry::{self, End, TelemetryThread};
-use super::wire::{EndReply, EndRequest, HostEvent, NodeEnd, RunOffer, RunRequest};
+use super::wire::{Answer, EndReply, EndRequest, HostEvent, NodeEnd, RunOffer, RunRequest};
 use crate::processes::namespace::Namespace;
 use crate::processes::node_log::last_bytes;
 use crate::processes::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
@@ -64,12 +65,12 @@ fn start(
     session: &zenoh::Session,
     req: &RunRequest,
     shared: &Shared,
-) -> Result<(Resources, Nodes), String> {
+) -> Result<(Resources, Nodes), StartError> {
     let (agent_bin, leader_bin) = find_binaries()?;
-    let ns = Namespace::create().map_err(|e| format!("namespace: {e}"))?;
+    let ns = Namespace::create().map_err(StartError::Namespace)?;
     let logs = ns.dir().join("logs");
-    std::fs::create_dir_all(&logs).map_err(|e| format!("{}: {e}", logs.display()))?;
-    let first = req.nodes.first().ok_or("a run without nodes")?;
+    std::fs::create_dir_all(&logs).map_err(io_at(&logs))?;
+    let first = req.nodes.first().ok_or(StartError::NoNodes)?;
     let local = LocalNs {
         run: ns.run().to_string(),
         dir: ns.dir().to_owned(),
@@ -77,12 +78,11 @@ fn start(
         stage_timeout: Duration::from_secs_f64(first.config.stage_timeout),
         realtime: first.config.realtime.is_some(),
     };
-    let node = local.node("host").map_err(|e| e.to_string())?;
-    let control = msgs::open::control(&node, &local.run, &local.limits)
-        .map_err(|e| e.to_string())?
+    let node = local.node("host")?;
+    let control = msgs::open::control(&node, &local.run, &local.limits)?
         .publisher_builder()
         .create()
-        .map_err(|e| iox("control publisher")(e).to_string())?;
+        .map_err(iox("control publisher"))?;
     let me = Side::Host(req.host.clone());
     let bridges = Bridges::start(session, &local, &req.run, &me, &req.links, shared);
     let ids = req.nodes.iter().map(|n| n.config.id).collect();
@@ -94,7 +94,7 @@ fn start(
         ids,
         shared,
     );
-    let mut sup = Supervisor::new().map_err(|e| format!("tokio runtime: {e}"))?;
+    let mut sup = Supervisor::new().map_err(StartError::Runtime)?;
     let mut nodes = Vec::new();
     for (i, n) in req.nodes.iter().enumerate() {
         let mut c = n.config.clone();
@@ -105,7 +105,7 @@ fn start(
             .dir
             .join(crate::results::layout::node_config_file(c.id));
         c.write(&file)
-            .map_err(|e| format!("{}: {e}", file.display()))?;
+            .map_err(|e| io_at(&file)(std::io::Error::other(e)))?;
         let log = logs.join(crate::results::layout::node_log_file(&n.name));
         let launch = match &n.plugin {
             Some(p) => Launch::Plugin {
@@ -116,7 +116,7 @@ fn start(
             None => Launch::Builtin(if c.id == 0 { &leader_bin } else { &agent_bin }),
         };
         sup.spawn_node(i, &launch, &file, &log)
-            .map_err(|e| format!("{}: {e}", log.display()))?;
+            .map_err(io_at(&log))?;
         nodes.push((c.id, n.name.clone(), log));
     }
     let r = Resources {
@@ -128,6 +128,12 @@ fn start(
         ns,
     };
     Ok((r, nodes))
+}
+
+/// Maps an I/O error at `path` to a [`StartError::Io`].
+fn io_at(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> StartError + use<> {
+    let path = path.to_owned();
+    move |source| StartError::Io { path, source }
 }
 
 /// Longest wait for the orchestrator to hand over a run's request.
@@ -146,7 +152,7 @@ pub fn serve_offer(
         Ok(req) => serve(session, req, reply, commands),
         Err(e) => {
             tracing::warn!(run = %offer.run, "refused: {e}");
-            answer(&reply, &Err(e));
+            answer(&reply, &Answer::Err(e.to_string()));
         }
     }
 }
@@ -154,7 +160,7 @@ pub fn serve_offer(
 /// `req` with each plug-in's program and directory as [`Allowlist::admit`]
 /// checked them (canonical), or the first refusal, naming the host, the
 /// node and its command (nothing has started).
-fn admit(mut req: RunRequest, allow: &Allowlist) -> Result<RunRequest, String> {
+fn admit(mut req: RunRequest, allow: &Allowlist) -> Result<RunRequest, RequestError> {
     for n in &mut req.nodes {
         let Some(p) = &mut n.plugin else { continue };
         let asked = Asked {
@@ -162,12 +168,14 @@ fn admit(mut req: RunRequest, allow: &Allowlist) -> Result<RunRequest, String> {
             env: &p.env,
             dir: &p.dir,
         };
-        let admitted = allow.admit(&asked).map_err(|reason| {
-            format!(
-                "host {} refuses {}'s plug-in command {:?}: {reason}",
-                req.host, n.name, p.command
-            )
-        })?;
+        let admitted = allow
+            .admit(&asked)
+            .map_err(|reason| RequestError::Refused {
+                host: req.host.clone(),
+                node: n.name.clone(),
+                command: p.command.clone(),
+                reason,
+            })?;
         p.command[0] = admitted.program.to_string_lossy().into_owned();
         p.dir = admitted.dir;
     }
@@ -175,27 +183,31 @@ fn admit(mut req: RunRequest, allow: &Allowlist) -> Result<RunRequest, String> {
 }
 
 /// The request of the run `offer` offers.
-fn fetch(session: &zenoh::Session, offer: &RunOffer) -> Result<RunRequest, String> {
+fn fetch(session: &zenoh::Session, offer: &RunOffer) -> Result<RunRequest, RequestError> {
     let replies = (session.get(super::keys::request(&offer.run, &offer.host)))
         .consolidation(zenoh::query::ConsolidationMode::None)
         .timeout(FETCH_TIMEOUT)
         .wait()
-        .map_err(|e| format!("zenoh: {e}"))?;
-    let bytes = pieces::collect(&replies).map_err(|e| format!("its request: {e}"))?;
+        .map_err(|e| RequestError::Zenoh(e.to_string()))?;
+    let bytes = pieces::collect(&replies)?;
     decode_request(&bytes, offer)
 }
 
 /// The run request in `bytes` (put back together from its pieces) for the
 /// run `offer` offered: its JSON, for that run and host, each node's values
 /// usable (`check_node`).
-pub fn decode_request(bytes: &[u8], offer: &RunOffer) -> Result<RunRequest, String> {
-    let req: RunRequest =
-        serde_json::from_slice(bytes).map_err(|e| format!("a bad request: {e}"))?;
+///
+/// # Errors
+/// [`RequestError`]: bad JSON, another run or host, or a node that cannot start.
+pub fn decode_request(bytes: &[u8], offer: &RunOffer) -> Result<RunRequest, RequestError> {
+    let req: RunRequest = serde_json::from_slice(bytes)?;
     if (req.run.as_str(), req.host.as_str()) != (offer.run.as_str(), offer.host.as_str()) {
-        return Err(format!(
-            "the request of run {} for {} came for run {} on {}",
-            offer.run, offer.host, req.run, req.host
-        ));
+        return Err(RequestError::Mismatch {
+            offered_run: offer.run.clone(),
+            offered_host: offer.host.clone(),
+            run: req.run,
+            host: req.host,
+        });
     }
     req.nodes.iter().try_for_each(check_node)?;
     Ok(req)
@@ -205,8 +217,11 @@ pub fn decode_request(bytes: &[u8], offer: &RunOffer) -> Result<RunRequest, Stri
 /// file name of its own (its log is `<name>.log` in the run's directory),
 /// or timeouts and a real-time factor outside what `attsync run` accepts
 /// (`Duration::from_secs_f64` panics on a negative or huge one).
-fn check_node(n: &super::wire::RemoteNode) -> Result<(), String> {
-    let bad = |e: &dyn std::fmt::Display| format!("a bad request: node {}: {e}", n.name);
+fn check_node(n: &super::wire::RemoteNode) -> Result<(), RequestError> {
+    let bad = |e: &dyn std::fmt::Display| RequestError::BadNode {
+        node: n.name.clone(),
+        why: e.to_string(),
+    };
     let safe = |ch: char| ch.is_ascii_alphanumeric() || ch == '-' || ch == '_';
     if n.name.is_empty() || !n.name.chars().all(safe) {
         return Err(bad(&"its name is not letters, digits, `-`, `_`"));
@@ -225,21 +240,19 @@ pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: R
     let shared = Shared::default();
     // Declared before the answer, so that no command of the run is missed.
     let Some(ports) = RunPorts::declare(&session, &req) else {
-        answer(
-            &reply,
-            &Err("zenoh: cannot declare the run's subscribers".into()),
-        );
+        let why = "zenoh: cannot declare the run's subscribers";
+        answer(&reply, &Answer::Err(why.into()));
         return;
     };
     let (mut res, nodes) = match start(&session, &req, &shared) {
         Ok(x) => x,
         Err(e) => {
             tracing::warn!(run = %req.run, "cannot start the run: {e}");
-            answer(&reply, &Err(e));
+            answer(&reply, &Answer::Err(e.to_string()));
             return;
         }
     };
-    answer(&reply, &Ok(()));
+    answer(&reply, &Answer::Ok(()));
     drop(reply); // its final reply: the orchestrator's query completes
     tracing::info!(run = %req.run, nodes = nodes.len(), "run started");
     let mut exits: Vec<Option<Exit>> = (0..nodes.len()).map(|_| None).collect();
@@ -442,7 +455,7 @@ fn reply_end(
 }
 
 /// Replies `a` to query `q` (in pieces, like every reply but a ping's).
-pub fn answer(q: &Query, a: &super::wire::Answer) {
+pub fn answer(q: &Query, a: &Answer) {
     pieces::reply(q, &serde_json::to_vec(a).expect("serialises"));
 }
 

@@ -21,6 +21,7 @@ pub mod bridge;
 pub mod client;
 pub mod daemon;
 pub mod host_run;
+mod host_run_error;
 pub mod keys;
 pub mod link;
 pub mod local;

@@ -68,8 +68,15 @@ pub struct RunRequest {
     pub links: Vec<StateLink>,
 }
 
-/// A daemon's answer to a request: `Ok` or why not.
-pub type Answer = Result<(), String>;
+/// A daemon's answer to a request: accepted, or refused with why (on the
+/// wire as serde writes a `Result`: `{"Ok":null}`, `{"Err":"…"}`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Answer {
+    /// Accepted.
+    Ok(()),
+    /// Refused: why, for a message.
+    Err(String),
+}
 
 /// Ends a run on a host (`attsync/host/<name>/end`).
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -191,30 +191,31 @@ pub struct Records {
 }
 
 /// Opens `file`, reads and checks its header and that its records are whole.
-pub fn open(file: &Path) -> Result<Records, String> {
-    let what = |e: &dyn std::fmt::Display| format!("{}: {e}", file.display());
-    let len = std::fs::metadata(file).map_err(|e| what(&e))?.len();
-    let mut r = BufReader::new(File::open(file).map_err(|e| what(&e))?);
-    let header: Header =
-        bincode::serde::decode_from_std_read(&mut r, header_config()).map_err(|e| what(&e))?;
+///
+/// # Errors
+/// [`StatesError`] naming `file`.
+pub fn open(file: &Path) -> Result<Records, StatesError> {
+    let what = |problem: StatesProblem| StatesError {
+        file: file.to_owned(),
+        problem,
+    };
+    let len = std::fs::metadata(file).map_err(|e| what(e.into()))?.len();
+    let mut r = BufReader::new(File::open(file).map_err(|e| what(e.into()))?);
+    let header: Header = bincode::serde::decode_from_std_read(&mut r, header_config())
+        .map_err(|e| what(e.into()))?;
     if header.magic != MAGIC {
-        return Err(what(&"not an attsync states file (bad magic)"));
+        return Err(what(StatesProblem::BadMagic));
     }
     if header.version != VERSION {
-        return Err(what(&format!(
-            "states layout version {} (this attsync reads {VERSION})",
-            header.version
-        )));
+        return Err(what(StatesProblem::Version(header.version)));
     }
     let header_len = bincode::serde::encode_to_vec(&header, config())
-        .map_err(|e| what(&e))?
+        .map_err(|e| what(e.into()))?
         .len() as u64;
     let record_len = 8 + 8 + 15 * 8 + header.agent_ids.len() as u64 * 27 * 8;
     let body = len.saturating_sub(header_len);
     if body % record_len != 0 {
-        return Err(what(&format!(
-            "truncated: {body} bytes of records is not a multiple of the record size {record_len}"
-        )));
+        return Err(what(StatesProblem::Truncated { body, record_len }));
     }
     Ok(Records {
         header,
@@ -228,19 +229,16 @@ pub fn open(file: &Path) -> Result<Records, String> {
 impl Records {
     /// The next record: its bytes read whole (the size every record has),
     /// then decoded; lengths inside that disagree with the header are refused.
-    fn record(&mut self) -> Result<Record, String> {
-        self.r
-            .read_exact(&mut self.buf)
-            .map_err(|e| e.to_string())?;
-        let (rec, used): (Record, usize) =
-            bincode::serde::decode_from_slice(&self.buf, config()).map_err(|e| e.to_string())?;
+    fn record(&mut self) -> Result<Record, StatesProblem> {
+        self.r.read_exact(&mut self.buf)?;
+        let (rec, used): (Record, usize) = bincode::serde::decode_from_slice(&self.buf, config())?;
         let agents = self.header.agent_ids.len();
         if used != self.buf.len() || rec.agents.len() != agents {
-            return Err(format!(
-                "record of step {} holds {} agents, the header {agents}",
-                rec.step,
-                rec.agents.len()
-            ));
+            return Err(StatesProblem::Agents {
+                step: rec.step,
+                agents: rec.agents.len(),
+                header: agents,
+            });
         }
         Ok(rec)
     }
@@ -253,22 +251,25 @@ impl Records {
 }
 
 impl Iterator for Records {
-    type Item = Result<Record, String>;
+    type Item = Result<Record, StatesError>;
 
     fn next(&mut self) -> Option<Self::Item> {
         if self.left == 0 {
             return None;
         }
         self.left -= 1;
-        Some(
-            self.record()
-                .map_err(|e| format!("{}: {e}", self.file.display())),
-        )
+        Some(self.record().map_err(|problem| StatesError {
+            file: self.file.clone(),
+            problem,
+        }))
     }
 }
 
 /// Reads a whole `states.bin`.
-pub fn read(file: &Path) -> Result<(Header, Vec<Record>), String> {
+///
+/// # Errors
+/// [`StatesError`] naming `file`.
+pub fn read(file: &Path) -> Result<(Header, Vec<Record>), StatesError> {
     let mut records = open(file)?;
     let mut all = Vec::with_capacity(records.remaining() as usize);
     for rec in &mut records {
@@ -305,9 +306,12 @@ impl AgentRecord {
 
 /// Converts `states.bin` to CSV, long form: one row per node per record,
 /// node 0 the leader (`r` = R₀, `w` = ω₀, `s_hat` = σ₀, observer columns empty).
-pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), String> {
+///
+/// # Errors
+/// [`CsvError`]: the file cannot be read, or the CSV written.
+pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), CsvError> {
     let (h, records) = read(file)?;
-    let io = |e: io::Error| format!("writing CSV: {e}");
+    let io = CsvError::Write;
     let mut cols = vec!["t".to_string(), "node".into()];
     for name in ["r", "r_hat"] {
         for i in 1..=3 {
@@ -364,6 +368,65 @@ pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Why a `states.bin` cannot be read.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {problem}", file.display())]
+pub struct StatesError {
+    /// The file.
+    pub file: std::path::PathBuf,
+    /// What is wrong.
+    pub problem: StatesProblem,
+}
+
+/// What is wrong with a `states.bin` ([`StatesError`]).
+#[derive(Debug, thiserror::Error)]
+pub enum StatesProblem {
+    /// It cannot be read.
+    #[error(transparent)]
+    Io(#[from] io::Error),
+    /// Its header or a record does not decode.
+    #[error(transparent)]
+    Decode(#[from] bincode::error::DecodeError),
+    /// Its header does not encode back (to measure it).
+    #[error(transparent)]
+    Encode(#[from] bincode::error::EncodeError),
+    /// It does not begin with [`MAGIC`].
+    #[error("not an attsync states file (bad magic)")]
+    BadMagic,
+    /// Its layout version is not [`VERSION`].
+    #[error("states layout version {0} (this attsync reads {VERSION})")]
+    Version(u32),
+    /// Its records are not whole.
+    #[error("truncated: {body} bytes of records is not a multiple of the record size {record_len}")]
+    Truncated {
+        /// Bytes after the header.
+        body: u64,
+        /// The size of one record.
+        record_len: u64,
+    },
+    /// A record holds another number of agents than the header.
+    #[error("record of step {step} holds {agents} agents, the header {header}")]
+    Agents {
+        /// The record's step.
+        step: u64,
+        /// Its agents.
+        agents: usize,
+        /// The header's.
+        header: usize,
+    },
+}
+
+/// Why `states.bin` could not be exported to CSV ([`export_csv`]).
+#[derive(Debug, thiserror::Error)]
+pub enum CsvError {
+    /// The states file cannot be read.
+    #[error(transparent)]
+    States(#[from] StatesError),
+    /// The CSV could not be written.
+    #[error("writing CSV: {0}")]
+    Write(io::Error),
 }
 
 #[cfg(test)]

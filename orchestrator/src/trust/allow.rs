@@ -45,7 +45,7 @@ impl Allowlist {
     /// Allows `paths` (from `--allow-plugin`): each must be an executable file.
     pub fn new(paths: &[PathBuf]) -> Result<Self, TrustError> {
         let programs = (paths.iter())
-            .map(|p| executable(p).map_err(|reason| file_error(p, reason)))
+            .map(|p| executable(p).map_err(|reason| file_error(p, &reason)))
             .collect::<Result<_, _>>()?;
         Ok(Self { programs })
     }
@@ -58,26 +58,28 @@ impl Allowlist {
 
     /// Admits `asked`, or says why not (for a message naming the host and
     /// the node).
-    pub fn admit(&self, asked: &Asked<'_>) -> Result<Admitted, String> {
+    ///
+    /// # Errors
+    /// [`AdmitError`]: the first reason to refuse it.
+    pub fn admit(&self, asked: &Asked<'_>) -> Result<Admitted, AdmitError> {
         let Some(first) = asked.command.first() else {
-            return Err("an empty command".into());
+            return Err(AdmitError::EmptyCommand);
         };
         if let Some(k) = asked.env.keys().find(|k| forbidden_env(k)) {
-            return Err(format!(
-                "its environment sets `{k}`, which no daemon takes from the network"
-            ));
+            return Err(AdmitError::ForbiddenEnv(k.clone()));
         }
-        let dir = std::fs::canonicalize(asked.dir)
-            .map_err(|e| format!("its directory {}: {e}", asked.dir.display()))?;
-        let found = resolve(first, &dir).ok_or_else(|| format!("`{first}` is not found here"))?;
-        let program = executable(&found).map_err(|e| format!("`{first}`: {e}"))?;
+        let dir = std::fs::canonicalize(asked.dir).map_err(|source| AdmitError::Dir {
+            dir: asked.dir.to_owned(),
+            source,
+        })?;
+        let found = resolve(first, &dir).ok_or_else(|| AdmitError::NotFound(first.clone()))?;
+        let program = executable(&found).map_err(|source| AdmitError::NotExecutable {
+            program: first.clone(),
+            source,
+        })?;
         if !self.programs.contains(&program) {
-            return Err(format!(
-                "`{}` is not allowed here (the daemon allows {}; start it with --allow-plugin {} to allow it)",
-                program.display(),
-                self.describe(),
-                program.display()
-            ));
+            let allowed = self.describe();
+            return Err(AdmitError::NotAllowed { program, allowed });
         }
         Ok(Admitted { program, dir })
     }
@@ -113,22 +115,75 @@ fn resolve(program: &str, dir: &Path) -> Option<PathBuf> {
 }
 
 /// `path`, canonical, if it is an executable regular file.
-fn executable(path: &Path) -> Result<PathBuf, String> {
+fn executable(path: &Path) -> Result<PathBuf, NotExecutable> {
     use std::os::unix::fs::PermissionsExt;
-    let canonical = std::fs::canonicalize(path).map_err(|e| e.to_string())?;
-    let meta = std::fs::metadata(&canonical).map_err(|e| e.to_string())?;
+    let canonical = std::fs::canonicalize(path)?;
+    let meta = std::fs::metadata(&canonical)?;
     if !meta.is_file() || meta.permissions().mode() & 0o111 == 0 {
-        return Err("not an executable file".into());
+        return Err(NotExecutable::NotAFile);
     }
     Ok(canonical)
 }
 
-fn file_error(p: &Path, reason: String) -> TrustError {
+fn file_error(p: &Path, reason: &NotExecutable) -> TrustError {
     TrustError::File {
         field: "--allow-plugin".into(),
         path: p.to_owned(),
-        reason,
+        reason: reason.to_string(),
     }
+}
+
+/// Why a path is not a program to start.
+#[derive(Debug, thiserror::Error)]
+pub enum NotExecutable {
+    /// It cannot be resolved or read.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// It is not a regular file with an execute bit.
+    #[error("not an executable file")]
+    NotAFile,
+}
+
+/// Why a daemon refuses a plug-in's command ([`Allowlist::admit`]).
+#[derive(Debug, thiserror::Error)]
+pub enum AdmitError {
+    /// The command has no program.
+    #[error("an empty command")]
+    EmptyCommand,
+    /// Its environment sets a variable no daemon takes from the network.
+    #[error("its environment sets `{0}`, which no daemon takes from the network")]
+    ForbiddenEnv(String),
+    /// Its working directory cannot be resolved.
+    #[error("its directory {}: {source}", dir.display())]
+    Dir {
+        /// The directory asked for.
+        dir: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Its program is not found from its directory or on `PATH`.
+    #[error("`{0}` is not found here")]
+    NotFound(String),
+    /// Its program is not an executable file.
+    #[error("`{program}`: {source}")]
+    NotExecutable {
+        /// The program asked for.
+        program: String,
+        /// Why not.
+        source: NotExecutable,
+    },
+    /// Its program is not on the daemon's allowlist.
+    #[error(
+        "`{}` is not allowed here (the daemon allows {allowed}; start it with --allow-plugin {} to allow it)",
+        program.display(),
+        program.display()
+    )]
+    NotAllowed {
+        /// The program, canonical.
+        program: PathBuf,
+        /// The programs allowed, for the message.
+        allowed: String,
+    },
 }
 
 #[cfg(test)]
@@ -154,7 +209,7 @@ mod tests {
         let cmd = vec!["/bin/../bin/sh".to_string()];
         assert_eq!(list.admit(&asked(&cmd, &env)).unwrap().program, sh);
         let none = Allowlist::default();
-        let e = none.admit(&asked(&cmd, &env)).unwrap_err();
+        let e = none.admit(&asked(&cmd, &env)).unwrap_err().to_string();
         assert!(e.contains("is not allowed here"), "{e}");
         assert!(e.contains("only the built-in nodes"), "{e}");
     }
@@ -165,11 +220,11 @@ mod tests {
         let cmd = vec!["/bin/sh".to_string()];
         for k in ["LD_PRELOAD", "LD_LIBRARY_PATH", "PATH"] {
             let env = BTreeMap::from([(k.to_string(), "/tmp".to_string())]);
-            let e = list.admit(&asked(&cmd, &env)).unwrap_err();
+            let e = list.admit(&asked(&cmd, &env)).unwrap_err().to_string();
             assert!(e.contains(k), "{e}");
         }
         let env = BTreeMap::new();
-        let e = list.admit(&asked(&[], &env)).unwrap_err();
+        let e = list.admit(&asked(&[], &env)).unwrap_err().to_string();
         assert!(e.contains("empty"), "{e}");
     }
 

@@ -136,9 +136,9 @@ pub fn states(recorded: &Path, rerun: &Path) -> Result<Option<StatesDifference>,
     };
     let mut a = match states::open(recorded) {
         Ok(x) => x,
-        Err(why) => return Ok(Some(StatesDifference::Unreadable(why))),
+        Err(why) => return Ok(Some(StatesDifference::Unreadable(why.to_string()))),
     };
-    let mut b = states::open(rerun).map_err(VerifyError::Read)?;
+    let mut b = states::open(rerun).map_err(|e| VerifyError::Read(e.to_string()))?;
     if let Some(d) = header(&a.header, &b.header) {
         return Ok(Some(d));
     }
@@ -232,9 +232,9 @@ fn records(a: &mut Records, b: &mut Records) -> Result<Option<StatesDifference>,
     for (index, (x, y)) in a.by_ref().zip(b.by_ref()).enumerate() {
         let x = match x {
             Ok(x) => x,
-            Err(why) => return Ok(Some(StatesDifference::Unreadable(why))),
+            Err(why) => return Ok(Some(StatesDifference::Unreadable(why.to_string()))),
         };
-        let y = y.map_err(VerifyError::Read)?;
+        let y = y.map_err(|e| VerifyError::Read(e.to_string()))?;
         if x.step != y.step {
             let (recorded, rerun) = (x.step, y.step);
             return Ok(Some(StatesDifference::Step {

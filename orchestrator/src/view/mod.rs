@@ -58,8 +58,8 @@ pub enum ViewError {
         reason: String,
     },
     /// Its `states.bin` cannot be read (the message names the file).
-    #[error("{0}")]
-    States(String),
+    #[error(transparent)]
+    States(#[from] crate::results::states::StatesError),
     /// Its `states.bin` is not of its scenario's network.
     #[error("{}: {reason}", file.display())]
     Mismatch {

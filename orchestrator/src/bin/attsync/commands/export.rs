@@ -36,7 +36,8 @@ pub fn exec(a: Export) -> Result<(), Error> {
         return mcap(&a.states, &out);
     }
     let mut text = Vec::new();
-    attsync::results::states::export_csv(&a.states, &mut text).map_err(Error::Export)?;
+    attsync::results::states::export_csv(&a.states, &mut text)
+        .map_err(|e| Error::Export(e.to_string()))?;
     super::write_output(a.out.as_deref(), &text)
 }
 
