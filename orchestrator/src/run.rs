@@ -566,7 +566,7 @@ fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Re
     } else {
         &[]
     };
-    plot::draw(&svg, &title, series, aoi).map_err(|message| RunError::Plot {
+    plot::draw(&svg, &title, series, aoi).map_err(|plot::PlotError(message)| RunError::Plot {
         path: svg.clone(),
         message,
     })?;

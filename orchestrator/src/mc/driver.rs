@@ -263,9 +263,11 @@ fn write_files(
     write(files.initial(), &initial)?;
     let svg = files.svg();
     let title = format!("{}: {} trials, seed {}", s.scenario, s.trials_run, s.seed);
-    plot::draw(&svg, &title, results).map_err(|message| McError::Plot {
-        path: svg.clone(),
-        message,
+    plot::draw(&svg, &title, results).map_err(|crate::results::plot::PlotError(message)| {
+        McError::Plot {
+            path: svg.clone(),
+            message,
+        }
     })?;
     let mut s = s.clone();
     s.complete = s.trials_run == s.trials;

@@ -2,7 +2,7 @@
 //! the histogram of the final errors on a log scale.
 
 use super::outcome::TrialResult;
-use crate::results::plot::{bars, canvas, chart, legend, line};
+use crate::results::plot::{PlotError, bars, canvas, chart, legend, line};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -14,12 +14,12 @@ type Pick = fn(&TrialResult) -> Option<f64>;
 const FLOOR: f64 = 1e-16;
 
 /// Draws both panels into `file` (SVG).
-pub fn draw(file: &Path, title: &str, results: &[TrialResult]) -> Result<(), String> {
+pub fn draw(file: &Path, title: &str, results: &[TrialResult]) -> Result<(), PlotError> {
     let root = canvas(file, (1000, 900), title)?;
     let (top, bottom) = root.split_vertically(440);
     ecdf(&top, results)?;
     histogram(&bottom, results)?;
-    root.present().map_err(|e| e.to_string())
+    root.present().map_err(PlotError::of)
 }
 
 /// The points of the ECDF of `times` (sorted) as a step line, over `n` trials.
@@ -37,18 +37,18 @@ fn steps(times: &[f64], n: usize, t_end: f64) -> Vec<(f64, f64)> {
 fn ecdf<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     results: &[TrialResult],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let n = results.len().max(1);
     let t_end = results.iter().map(|r| r.t_end).fold(1e-9, f64::max);
     let caption = "fraction of trials settled (ECDF of settle times; never settled: not reached)";
     let mut chart = chart(area, caption, 60)
         .build_cartesian_2d(0.0..t_end, 0.0..1.0)
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     chart
         .configure_mesh()
         .x_desc("settle time (s)")
         .draw()
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     let curves: [(&str, Pick, RGBColor); 2] = [
         ("att < 1e-3", |r| r.settle.att_1e3, BLUE),
         ("att < 1e-6", |r| r.settle.att_1e6, RED),
@@ -79,7 +79,7 @@ fn bins(values: impl Iterator<Item = f64>, lo: i32, hi: i32) -> Vec<u32> {
 fn histogram<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     results: &[TrialResult],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let (lo, hi) = (-16, 2);
     let att = bins(results.iter().map(|r| r.final_max_att_err), lo, hi);
     let angvel = bins(results.iter().map(|r| r.final_max_angvel_err), lo, hi);
@@ -87,13 +87,13 @@ fn histogram<DB: DrawingBackend>(
     let caption = "final max error over agents (histogram, log10 bins)";
     let mut chart = chart(area, caption, 60)
         .build_cartesian_2d(f64::from(lo)..f64::from(hi), 0.0..f64::from(top) * 1.1)
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     chart
         .configure_mesh()
         .x_desc("log10 error (att: |R_i R_0^T|_I; angvel: rad/s)")
         .y_desc("trials")
         .draw()
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     let series = [
         ("att_err", &att, BLUE, 0.05),
         ("angvel_err", &angvel, RED, 0.5),

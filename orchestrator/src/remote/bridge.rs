@@ -10,6 +10,8 @@
 //! ([`super::link::STATE_FRESHEST`]), as a network would.
 
 use super::Side;
+pub use super::bridge_error::BridgeError;
+use super::bridge_error::debug;
 use super::keys;
 use super::link::{Flow, LinkReceiver, LinkSender, STATE_DEPTH, STATE_FRESHEST, STATE_WINDOW};
 use super::local::{LocalNs, Shared};
@@ -107,13 +109,20 @@ struct Outgoing {
 impl Outgoing {
     /// Reads what the queue holds and forwards what the window allows;
     /// whether anything moved.
-    fn pump(&mut self) -> Result<bool, String> {
+    fn pump(&mut self) -> Result<bool, BridgeError> {
         let mut moved = false;
         for s in &self.subs[1..] {
-            while s.receive().map_err(|e| format!("{e:?}"))?.is_some() {}
+            while s
+                .receive()
+                .map_err(|e| BridgeError::Receive(debug(e)))?
+                .is_some()
+            {}
         }
         while self.queue.len() < QUEUE {
-            let Some(m) = self.subs[0].receive().map_err(|e| format!("{e:?}"))? else {
+            let Some(m) = self.subs[0]
+                .receive()
+                .map_err(|e| BridgeError::Receive(debug(e)))?
+            else {
                 break;
             };
             self.queue.push_back(m.to_bytes());
@@ -123,7 +132,7 @@ impl Outgoing {
             let Some(bytes) = self.queue.pop_front() else {
                 break;
             };
-            self.link.send_now(bytes).map_err(|e| e.to_string())?;
+            self.link.send_now(bytes)?;
             moved = true;
         }
         Ok(moved)
@@ -153,14 +162,13 @@ fn send_states(
     run: &str,
     links: &[StateLink],
     sh: &Shared,
-) -> Result<(), String> {
-    let node = ns.node("bridge-out").map_err(|e| e.to_string())?;
+) -> Result<(), BridgeError> {
+    let node = ns.node("bridge-out")?;
     let mut out = Vec::new();
     for l in links {
-        let svc =
-            msgs::open::state(&node, &ns.run, l.from, &ns.limits).map_err(|e| e.to_string())?;
+        let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits)?;
         let key = keys::state_link(run, l.from, &l.to_side);
-        let link = LinkSender::open(session, &key, state_flow(ns)).map_err(|e| e.to_string())?;
+        let link = LinkSender::open(session, &key, state_flow(ns))?;
         if !publisher_is_up(&svc, sh) {
             return Ok(()); // the run ended first
         }
@@ -181,21 +189,20 @@ fn send_states(
     remote.dedup();
     let listeners = (remote.iter())
         .map(|&r| {
-            msgs::open::wake(&node, &ns.run, r, &ns.limits)
-                .map_err(|e| e.to_string())?
+            msgs::open::wake(&node, &ns.run, r, &ns.limits)?
                 .listener_builder()
                 .create()
-                .map_err(|e| iox("bridge wake listener")(e).to_string())
+                .map_err(|e| BridgeError::from(iox("bridge wake listener")(e)))
         })
         .collect::<Result<Vec<_>, _>>()?;
     let waitset = WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
-        .map_err(|e| format!("iceoryx2 waitset: {e:?}"))?;
+        .map_err(|e| BridgeError::WaitSet(debug(e)))?;
     let _guards = (listeners.iter())
         .map(|l| waitset.attach_notification(l))
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| format!("iceoryx2 waitset: {e:?}"))?;
+        .map_err(|e| BridgeError::WaitSet(debug(e)))?;
     while !sh.stopping() {
         let _ =
             waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, SLICE);
@@ -231,11 +238,11 @@ fn publisher_is_up(svc: &StateService, sh: &Shared) -> bool {
 /// the subscriber's side is connected; before that its blocking send skips
 /// the subscriber without an error, and a sender that runs ahead (the
 /// leader) would lose its states from the 65th on.
-fn subscribe(svc: &StateService, buffer: usize) -> Result<StateSubscriber, String> {
+fn subscribe(svc: &StateService, buffer: usize) -> Result<StateSubscriber, BridgeError> {
     let sub = (svc.subscriber_builder().buffer_size(buffer).create())
-        .map_err(|e| iox("bridge state subscriber")(e).to_string())?;
+        .map_err(iox("bridge state subscriber"))?;
     sub.update_connections()
-        .map_err(|e| format!("bridge state subscriber: {e:?}"))?;
+        .map_err(|e| BridgeError::Connect(debug(e)))?;
     Ok(sub)
 }
 
@@ -252,32 +259,29 @@ fn receive_states(
     key: &str,
     l: &StateLink,
     sh: &Shared,
-) -> Result<(), String> {
-    let node = ns
-        .node(&format!("bridge-in-{}", l.from))
-        .map_err(|e| e.to_string())?;
-    let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits).map_err(|e| e.to_string())?;
+) -> Result<(), BridgeError> {
+    let node = ns.node(&format!("bridge-in-{}", l.from))?;
+    let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits)?;
     let publisher = svc
         .publisher_builder()
         .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
         .set_backpressure_handler(hold_back(ns.stage_timeout, sh.clone()))
         .create()
-        .map_err(|e| iox("bridge state publisher")(e).to_string())?;
+        .map_err(iox("bridge state publisher"))?;
     let notifiers = (l.receivers.iter())
         .map(|&r| {
-            msgs::open::wake(&node, &ns.run, r, &ns.limits)
-                .map_err(|e| e.to_string())?
+            msgs::open::wake(&node, &ns.run, r, &ns.limits)?
                 .notifier_builder()
                 .create()
-                .map_err(|e| iox("bridge wake notifier")(e).to_string())
+                .map_err(|e| BridgeError::from(iox("bridge wake notifier")(e)))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut link = LinkReceiver::open(session, key, state_flow(ns)).map_err(|e| e.to_string())?;
+    let mut link = LinkReceiver::open(session, key, state_flow(ns))?;
     while !sh.stopping() {
-        let Some(bytes) = link.recv(SLICE * 20).map_err(|e| e.to_string())? else {
+        let Some(bytes) = link.recv(SLICE * 20)? else {
             continue;
         };
-        let m = StateMsg::from_bytes(&bytes).map_err(|e| e.to_string())?;
+        let m = StateMsg::from_bytes(&bytes)?;
         if sh.stopping() {
             break;
         }
@@ -286,7 +290,7 @@ fn receive_states(
             want: l.receivers.len(),
         };
         deliver(&publisher, &to, m, ns.stage_timeout, sh)?;
-        link.delivered().map_err(|e| e.to_string())?;
+        link.delivered()?;
     }
     Ok(())
 }
@@ -311,10 +315,10 @@ fn deliver(
     m: StateMsg,
     timeout: Duration,
     sh: &Shared,
-) -> Result<(), String> {
+) -> Result<(), BridgeError> {
     let start = std::time::Instant::now();
     loop {
-        let got = (publisher.send_copy(m)).map_err(|e| iox("bridge state send")(e).to_string())?;
+        let got = (publisher.send_copy(m)).map_err(iox("bridge state send"))?;
         for n in to.notifiers {
             let _ = n.notify();
         }
@@ -323,19 +327,24 @@ fn deliver(
         }
         let (step, stage) = (m.step, m.stage);
         if got > 0 {
-            return Err(format!(
-                "step {step} stage {stage} reached {got} of its {} receivers here",
-                to.want
-            ));
+            let want = to.want;
+            return Err(BridgeError::Partial {
+                step,
+                stage,
+                got,
+                want,
+            });
         }
         if sh.stopping() {
             return Ok(()); // the run is ending: nobody waits for it
         }
         if start.elapsed() > timeout {
-            return Err(format!(
-                "step {step} stage {stage} reached none of its receivers here in {:.1} s",
-                timeout.as_secs_f64()
-            ));
+            let seconds = timeout.as_secs_f64();
+            return Err(BridgeError::Undelivered {
+                step,
+                stage,
+                seconds,
+            });
         }
         std::thread::sleep(Duration::from_micros(50));
     }

@@ -18,6 +18,7 @@
 //! - [`daemon`], [`host_run`]: the host's side.
 
 pub mod bridge;
+mod bridge_error;
 pub mod client;
 pub mod daemon;
 pub mod host_run;

@@ -6,6 +6,7 @@
 //! orchestrator collects remote nodes exactly as local ones (its sender
 //! check included).
 
+use super::bridge::BridgeError;
 use super::keys;
 use super::link::{LinkReceiver, LinkSender, TELEMETRY_WINDOW};
 use super::local::{LocalNs, Shared};
@@ -41,12 +42,24 @@ fn frame(service: u32, m: &TelemetryMsg) -> Vec<u8> {
 
 /// The service id and message of a frame (what the orchestrator's side
 /// decodes of each message on a host's telemetry link).
-pub fn unframe(b: &[u8]) -> Result<(u32, TelemetryMsg), String> {
-    let (id, m) = b
-        .split_at_checked(4)
-        .ok_or("a telemetry frame of under 4 bytes")?;
+///
+/// # Errors
+/// [`FrameError`]: too short, or not a telemetry message.
+pub fn unframe(b: &[u8]) -> Result<(u32, TelemetryMsg), FrameError> {
+    let (id, m) = b.split_at_checked(4).ok_or(FrameError::Short)?;
     let id = u32::from_le_bytes(id.try_into().expect("4 bytes"));
-    Ok((id, TelemetryMsg::from_bytes(m).map_err(|e| e.to_string())?))
+    Ok((id, TelemetryMsg::from_bytes(m)?))
+}
+
+/// Why a frame off a host's telemetry link does not decode ([`unframe`]).
+#[derive(Debug, thiserror::Error)]
+pub enum FrameError {
+    /// It is too short to hold a service id.
+    #[error("a telemetry frame of under 4 bytes")]
+    Short,
+    /// Its message is not a telemetry message.
+    #[error(transparent)]
+    Message(#[from] msgs::bytes::WrongSize),
 }
 
 /// What a telemetry thread works with.
@@ -64,7 +77,7 @@ struct Ends {
 
 impl Ends {
     /// Runs `f` on a thread of its own; its error is the run's failure.
-    fn spawn(self, what: &'static str, f: fn(&Ends) -> Result<(), String>) -> TelemetryThread {
+    fn spawn(self, what: &'static str, f: fn(&Ends) -> Result<(), BridgeError>) -> TelemetryThread {
         let sh = self.sh.clone();
         let t = std::thread::spawn(move || {
             if let Err(e) = f(&self) {
@@ -108,36 +121,36 @@ pub fn start(
     }
 }
 
-fn forward_loop(e: &Ends) -> Result<(), String> {
+fn forward_loop(e: &Ends) -> Result<(), BridgeError> {
     let (session, ns, key, ids, sh) = (&e.session, &e.ns, e.key.as_str(), e.ids.as_slice(), &e.sh);
-    let node = ns.node("host-telemetry").map_err(|e| e.to_string())?;
-    let wake = msgs::open::orchestrator_wake(&node, &ns.run, &ns.limits)
-        .map_err(|e| e.to_string())?
+    let node = ns.node("host-telemetry")?;
+    let wake = msgs::open::orchestrator_wake(&node, &ns.run, &ns.limits)?
         .listener_builder()
         .create()
-        .map_err(|e| iox("telemetry wake listener")(e).to_string())?;
+        .map_err(iox("telemetry wake listener"))?;
     let subs = (ids.iter())
         .map(|&id| {
-            msgs::open::telemetry(&node, &ns.run, id, &ns.limits)
-                .map_err(|e| e.to_string())?
+            msgs::open::telemetry(&node, &ns.run, id, &ns.limits)?
                 .subscriber_builder()
                 .buffer_size(ns.limits.telemetry_buffer)
                 .create()
-                .map_err(|e| iox("telemetry subscriber")(e).to_string())
+                .map_err(|e| BridgeError::from(iox("telemetry subscriber")(e)))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut link = LinkSender::open(session, key, TELEMETRY_WINDOW).map_err(|e| e.to_string())?;
+    let mut link = LinkSender::open(session, key, TELEMETRY_WINDOW)?;
     let stop = || false;
     loop {
         // Drain once more after the stop: the last reports (Done, Failed) go too.
         let last = sh.stopping();
         let _ = wake.timed_wait(|_| {}, POLL);
         for (sub, &id) in subs.iter().zip(ids) {
-            while let Some(m) = sub.receive().map_err(|e| format!("{e:?}"))? {
+            while let Some(m) = sub
+                .receive()
+                .map_err(|e| BridgeError::Receive(format!("{e:?}")))?
+            {
                 let bytes = frame(id, &m);
                 drop(m);
-                link.send(bytes, ns.stage_timeout, &stop)
-                    .map_err(|e| e.to_string())?;
+                link.send(bytes, ns.stage_timeout, &stop)?;
             }
         }
         if last {
@@ -146,38 +159,31 @@ fn forward_loop(e: &Ends) -> Result<(), String> {
     }
 }
 
-fn sink_loop(e: &Ends) -> Result<(), String> {
+fn sink_loop(e: &Ends) -> Result<(), BridgeError> {
     let (session, ns, key, ids, sh) = (&e.session, &e.ns, e.key.as_str(), e.ids.as_slice(), &e.sh);
     let host = e.host.as_str();
-    let node = ns
-        .node(&format!("telemetry-of-{host}"))
-        .map_err(|e| e.to_string())?;
+    let node = ns.node(&format!("telemetry-of-{host}"))?;
     let pubs = (ids.iter())
         .map(|&id| {
-            msgs::open::telemetry(&node, &ns.run, id, &ns.limits)
-                .map_err(|e| e.to_string())?
+            msgs::open::telemetry(&node, &ns.run, id, &ns.limits)?
                 .publisher_builder()
                 .backpressure_strategy(BackpressureStrategy::RetryUntilDelivered)
                 .create()
-                .map_err(|e| iox("telemetry publisher")(e).to_string())
+                .map_err(|e| BridgeError::from(iox("telemetry publisher")(e)))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let wake = msgs::open::orchestrator_wake(&node, &ns.run, &ns.limits)
-        .map_err(|e| e.to_string())?
+    let wake = msgs::open::orchestrator_wake(&node, &ns.run, &ns.limits)?
         .notifier_builder()
         .create()
-        .map_err(|e| iox("orchestrator notifier")(e).to_string())?;
-    let mut link = LinkReceiver::open(session, key, TELEMETRY_WINDOW).map_err(|e| e.to_string())?;
+        .map_err(iox("orchestrator notifier"))?;
+    let mut link = LinkReceiver::open(session, key, TELEMETRY_WINDOW)?;
     while !sh.stopping() {
-        let Some(b) = link.recv(POLL).map_err(|e| e.to_string())? else {
+        let Some(b) = link.recv(POLL)? else {
             continue;
         };
         let (id, m) = unframe(&b)?;
-        let k = (ids.iter().position(|&i| i == id))
-            .ok_or_else(|| format!("telemetry of node {id}, which is not placed on it"))?;
-        pubs[k]
-            .send_copy(m)
-            .map_err(|e| iox("telemetry send")(e).to_string())?;
+        let k = (ids.iter().position(|&i| i == id)).ok_or(BridgeError::NotPlaced(id))?;
+        pubs[k].send_copy(m).map_err(iox("telemetry send"))?;
         let sample = matches!(
             m.decode(),
             Ok(Telemetry::Sample { .. } | Telemetry::LeaderSample { .. })
@@ -185,7 +191,7 @@ fn sink_loop(e: &Ends) -> Result<(), String> {
         if !sample {
             let _ = wake.notify();
         }
-        link.delivered().map_err(|e| e.to_string())?;
+        link.delivered()?;
     }
     Ok(())
 }

@@ -17,6 +17,19 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
+/// Why a chart could not be drawn: the drawing backend's error, as text
+/// (plotters' errors are generic over the backend).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct PlotError(pub String);
+
+impl PlotError {
+    /// A drawing error `e`.
+    pub fn of(e: impl std::fmt::Display) -> Self {
+        Self(e.to_string())
+    }
+}
+
 /// Smallest value drawn on the log axes (exact zeros are clamped to it).
 const FLOOR: f64 = 1e-16;
 /// Height of one panel, px.
@@ -37,7 +50,7 @@ pub fn draw(
     title: &str,
     series: &[Series],
     aoi: &[LinkSummary],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let observer = series.iter().any(|s| !s.obs_att.is_empty());
     let panels = 2 + if observer { 2 } else { 0 } + usize::from(!aoi.is_empty());
     let root = canvas(file, (1000, PANEL_HEIGHT * panels as u32), title)?;
@@ -58,14 +71,14 @@ pub fn draw(
     if let Some(area) = areas.last().filter(|_| !aoi.is_empty()) {
         aoi_bars(area, aoi)?;
     }
-    root.present().map_err(|e| e.to_string())
+    root.present().map_err(PlotError::of)
 }
 
 /// The mean and largest age of information of each link, as bars (ms).
 fn aoi_bars<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     links: &[LinkSummary],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let n = links.len();
     let ms = |x: f64| if x.is_finite() { x * 1e3 } else { 0.0 };
     let top = links
@@ -76,7 +89,7 @@ fn aoi_bars<DB: DrawingBackend>(
         * 1.15;
     let mut chart = chart(area, AOI, 70)
         .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top)
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     let label = |x: &f64| {
         let k = x.round();
         match links.get(k as usize) {
@@ -91,7 +104,7 @@ fn aoi_bars<DB: DrawingBackend>(
         .x_label_formatter(&label)
         .y_desc("ms")
         .draw()
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     let kinds = [
         ("mean age", 0.0, Palette99::pick(0)),
         ("max age", 0.4, Palette99::pick(1)),
@@ -113,7 +126,7 @@ fn panel<DB: DrawingBackend>(
     label: &str,
     series: &[Series],
     pick: impl Fn(&Series) -> &[f64],
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let t_end = series
         .iter()
         .filter_map(|s| s.t.last().copied())
@@ -132,13 +145,13 @@ fn panel<DB: DrawingBackend>(
     };
     let mut chart = chart(area, label, 70)
         .build_cartesian_2d(0.0..t_end, (lo..hi).log_scale())
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     chart
         .configure_mesh()
         .x_desc("t (s)")
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     if series.len() > EACH_AGENT_UP_TO {
         band_of_agents(&mut chart, series.len(), &band(series, &pick))?;
     } else {
@@ -159,7 +172,7 @@ fn band_of_agents<'a, DB, CT>(
     chart: &mut ChartContext<'a, DB, CT>,
     agents: usize,
     b: &Band,
-) -> Result<(), String>
+) -> Result<(), PlotError>
 where
     DB: DrawingBackend + 'a,
     CT: CoordTranslate<From = (f64, f64)>,
@@ -168,8 +181,7 @@ where
     let lower = floored(decimate(&b.t, &b.min, POINTS_PER_LINE));
     let outline: Vec<(f64, f64)> = upper.clone().chain(lower.clone().rev()).collect();
     let shade = Palette99::pick(0).mix(0.2).filled();
-    (chart.draw_series(std::iter::once(Polygon::new(outline, shade))))
-        .map_err(|e| e.to_string())?;
+    (chart.draw_series(std::iter::once(Polygon::new(outline, shade)))).map_err(PlotError::of)?;
     let lines = [
         (
             format!("largest of {agents} agents"),
@@ -206,11 +218,11 @@ pub(crate) fn canvas<'a>(
     file: &'a Path,
     size: (u32, u32),
     title: &str,
-) -> Result<DrawingArea<SVGBackend<'a>, Shift>, String> {
+) -> Result<DrawingArea<SVGBackend<'a>, Shift>, PlotError> {
     let root = SVGBackend::new(file, size).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.fill(&WHITE).map_err(PlotError::of)?;
     root.titled(title, ("sans-serif", 22))
-        .map_err(|e| e.to_string())
+        .map_err(PlotError::of)
 }
 
 /// A chart on `area` captioned `caption` (sans-serif 16): 12 px margins,
@@ -235,14 +247,14 @@ pub(crate) fn line<'a, DB, CT>(
     points: impl IntoIterator<Item = (f64, f64)>,
     style: ShapeStyle,
     label: impl Into<String>,
-) -> Result<(), String>
+) -> Result<(), PlotError>
 where
     DB: DrawingBackend + 'a,
     CT: CoordTranslate<From = (f64, f64)>,
 {
     chart
         .draw_series(LineSeries::new(points, style))
-        .map_err(|e| e.to_string())?
+        .map_err(PlotError::of)?
         .label(label)
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
     Ok(())
@@ -256,14 +268,14 @@ pub(crate) fn bars<'a, DB, CT>(
     label: &str,
     style: ShapeStyle,
     width: i32,
-) -> Result<(), String>
+) -> Result<(), PlotError>
 where
     DB: DrawingBackend + 'a,
     CT: CoordTranslate<From = (f64, f64)>,
 {
     chart
         .draw_series(rects)
-        .map_err(|e| e.to_string())?
+        .map_err(PlotError::of)?
         .label(label)
         .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + width, y + 5)], style));
     Ok(())
@@ -274,7 +286,7 @@ where
 pub(crate) fn legend<'a, DB, CT>(
     chart: &mut ChartContext<'a, DB, CT>,
     position: SeriesLabelPosition,
-) -> Result<(), String>
+) -> Result<(), PlotError>
 where
     DB: DrawingBackend + 'a,
     CT: CoordTranslate,
@@ -285,7 +297,7 @@ where
         .border_style(BLACK)
         .position(position)
         .draw()
-        .map_err(|e| e.to_string())
+        .map_err(PlotError::of)
 }
 
 #[cfg(test)]

@@ -71,7 +71,8 @@ pub(super) fn write(
     let info = serde_json::to_string_pretty(&info).expect("json") + "\n";
     let file = layout.json();
     std::fs::write(&file, &info).map_err(io_at(&file))?;
-    super::plot::draw(&layout.svg(), &o.param, base, rows, margin).map_err(SweepError::Plot)?;
+    super::plot::draw(&layout.svg(), &o.param, base, rows, margin)
+        .map_err(|e| SweepError::Plot(e.0))?;
     let file = layout.summary();
     std::fs::write(&file, &info).map_err(io_at(&file))
 }

@@ -6,6 +6,7 @@
 
 use super::SweepRow;
 use super::margin::{DELAY_FIELD, LinearMargin, MarginResult};
+use crate::results::plot::PlotError;
 use crate::scenario::Loaded;
 use attsync_verdict::Kind;
 use plotters::prelude::*;
@@ -58,7 +59,7 @@ pub(super) fn draw(
     base: &Loaded,
     rows: &[SweepRow],
     margin: Option<&MarginResult>,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let dots: Vec<(f64, f64, Kind)> = rows
         .iter()
         .filter_map(|r| {
@@ -85,7 +86,7 @@ pub(super) fn draw(
     let (y0, y1) = ys.fold((0.0_f64, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
     let pad = 0.08 * (y1 - y0).max(1e-3);
     let root = SVGBackend::new(file, (900, 520)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.fill(&WHITE).map_err(PlotError::of)?;
     let mut chart = ChartBuilder::on(&root)
         .margin(15)
         .caption(
@@ -95,15 +96,15 @@ pub(super) fn draw(
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
-        .map_err(|e| e.to_string())?;
+        .map_err(PlotError::of)?;
     chart
         .configure_mesh()
         .x_desc(param)
         .y_desc("decay rate [1/s] (< 0: decays)")
         .y_label_formatter(&|v| format!("{:.3}", if v.abs() < 1e-12 { 0.0 } else { *v }))
         .draw()
-        .map_err(|e| e.to_string())?;
-    let e = |e: DrawingAreaErrorKind<_>| e.to_string();
+        .map_err(PlotError::of)?;
+    let e = |e: DrawingAreaErrorKind<_>| PlotError::of(e);
     chart
         .draw_series(LineSeries::new(
             [(x0, 0.0), (x1, 0.0)],
@@ -143,5 +144,5 @@ pub(super) fn draw(
         .border_style(BLACK)
         .draw()
         .map_err(e)?;
-    root.present().map_err(|e| e.to_string())
+    root.present().map_err(PlotError::of)
 }
