@@ -211,7 +211,7 @@ impl Drive<'_> {
         }
         match self.tcheck.verdict() {
             Ok(()) => self.report.pass(RuleId::Telemetry),
-            Err(why) => self.report.fail(RuleId::Telemetry, why),
+            Err(why) => self.report.fail(RuleId::Telemetry, why.to_string()),
         }
         self.record.samples = std::mem::take(&mut self.tcheck.samples);
         super::law::judge(self.cfg, &self.record, self.opts.law, self.report);

@@ -86,9 +86,9 @@ impl TelemetryCheck {
     }
 
     /// Rule `telemetry`'s verdict: the first problem seen, else missing samples or `Done`.
-    pub(super) fn verdict(&self) -> Result<(), String> {
+    pub(super) fn verdict(&self) -> Result<(), TelemetryFault> {
         if let Some(p) = &self.problem {
-            return Err(p.clone());
+            return Err(TelemetryFault::Seen(p.clone()));
         }
         if self.seen != self.expected {
             let first = self
@@ -97,18 +97,47 @@ impl TelemetryCheck {
                 .zip(&self.expected)
                 .position(|(a, b)| a != b)
                 .unwrap_or(self.seen.len().min(self.expected.len()));
-            return Err(format!(
-                "samples at steps {:?}… (from the {}th) where {:?}… were due ({} of {} received)",
-                &self.seen[first.min(self.seen.len())..self.seen.len().min(first + 3)],
-                first + 1,
-                &self.expected[first.min(self.expected.len())..self.expected.len().min(first + 3)],
-                self.seen.len(),
-                self.expected.len()
-            ));
+            return Err(TelemetryFault::Steps {
+                seen: self.seen[first.min(self.seen.len())..self.seen.len().min(first + 3)]
+                    .to_vec(),
+                from: first + 1,
+                due: (self.expected
+                    [first.min(self.expected.len())..self.expected.len().min(first + 3)])
+                    .to_vec(),
+                received: self.seen.len(),
+                expected: self.expected.len(),
+            });
         }
         if !self.done {
-            return Err("no Done after the last step".into());
+            return Err(TelemetryFault::NoDone);
         }
         Ok(())
     }
+}
+
+/// Why a candidate fails rule `telemetry` ([`TelemetryCheck::verdict`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub(super) enum TelemetryFault {
+    /// The first problem seen in its reports.
+    #[error("{0}")]
+    Seen(String),
+    /// Its samples are not at the steps due.
+    #[error(
+        "samples at steps {seen:?}… (from the {from}th) where {due:?}… were due ({received} of {expected} received)"
+    )]
+    Steps {
+        /// Up to three steps received, from the first that differs.
+        seen: Vec<u64>,
+        /// The position of the first that differs, from 1.
+        from: usize,
+        /// The steps due there.
+        due: Vec<u64>,
+        /// Samples received.
+        received: usize,
+        /// Samples due.
+        expected: usize,
+    },
+    /// No `Done` came after the last step.
+    #[error("no Done after the last step")]
+    NoDone,
 }

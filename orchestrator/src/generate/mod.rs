@@ -13,9 +13,11 @@
 //!   ([`write_file`], [`write_scenario`]: the bytes of `toml::to_string`).
 
 mod draw;
+mod error;
 mod pick;
 mod write;
 
+pub use error::TreeError;
 pub use pick::{CONVERGE_MULTIPLE, DEFAULT_DURATION, DT_FRACTION, K_SIGMA_MARGIN};
 pub use write::{WriteError, write_file, write_scenario};
 
@@ -96,12 +98,12 @@ pub struct Generated {
 /// # Errors
 /// Parameters out of range, or a given duration `check` would refuse with
 /// the picked `dt` (not a whole multiple of it, or beyond the step limit).
-pub fn tree(p: &TreeParams) -> Result<Generated, String> {
+pub fn tree(p: &TreeParams) -> Result<Generated, TreeError> {
     if p.agents == 0 {
-        return Err("--agents must be ≥ 1".into());
+        return Err(TreeError::NoAgents);
     }
     if p.leader_links == 0 || p.leader_links > p.agents {
-        return Err(format!("--leader-links must be in 1..={}", p.agents));
+        return Err(TreeError::LeaderLinks { agents: p.agents });
     }
     let mut scenario = draw_tree(p);
     let (notes, warning) = match pick::Analysis::of(&mut scenario) {
@@ -110,13 +112,14 @@ pub fn tree(p: &TreeParams) -> Result<Generated, String> {
     };
     if let Some(issue) = timing_issues(&scenario.simulation, &scenario.output).first() {
         let dt = scenario.simulation.dt;
+        let issue = issue.to_string();
         return Err(match p.duration {
-            Some(d) => format!(
-                "--duration {d}: {issue} (simulation.dt = {dt} s is what this tree needs: pass a whole multiple of it, at most 2^40 steps; without --duration the longest allowed is picked)"
-            ),
-            None => format!(
-                "the tree needs simulation.dt = {dt} s, too small for a horizon of a whole 10 s within 2^40 steps: {issue}"
-            ),
+            Some(duration) => TreeError::Duration {
+                duration,
+                issue,
+                dt,
+            },
+            None => TreeError::TooFine { issue, dt },
         });
     }
     Ok(Generated {

@@ -35,18 +35,21 @@ pub struct Subject {
     pub addresses: Vec<String>,
 }
 
+/// A `--for` that is not `NAME` or `NAME=ADDR[,ADDR…]` (the name given).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("`{0}` is not a name (letters, digits, `-`, `_`): write NAME or NAME=ADDR[,ADDR…]")]
+pub struct BadSubject(pub String);
+
 impl FromStr for Subject {
-    type Err = String;
+    type Err = BadSubject;
 
     /// `NAME` or `NAME=ADDR[,ADDR…]`.
-    fn from_str(s: &str) -> Result<Self, String> {
+    fn from_str(s: &str) -> Result<Self, BadSubject> {
         let (name, addrs) = s.split_once('=').unwrap_or((s, ""));
         let ok = !name.is_empty()
             && (name.chars()).all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
         if !ok {
-            return Err(format!(
-                "`{name}` is not a name (letters, digits, `-`, `_`): write NAME or NAME=ADDR[,ADDR…]"
-            ));
+            return Err(BadSubject(name.to_string()));
         }
         let addresses = (addrs.split(',').filter(|a| !a.is_empty()))
             .map(str::to_string)

@@ -26,11 +26,11 @@ pub(super) fn guard(c: &mut Ctx, g: &GuardSpec) -> Envelope {
 mod tests {
     use std::path::Path;
 
-    fn load(sets: &[&str]) -> Result<crate::scenario::Loaded, String> {
+    fn load(sets: &[&str]) -> Result<crate::scenario::Loaded, crate::scenario::ScenarioError> {
         let file =
             Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/timevarying.toml");
         let sets: Vec<String> = sets.iter().map(|s| (*s).to_string()).collect();
-        crate::scenario::load(&file, &sets).map_err(|e| e.to_string())
+        crate::scenario::load(&file, &sets)
     }
 
     #[test]
@@ -46,13 +46,16 @@ mod tests {
 
     #[test]
     fn a_bound_must_be_finite_and_positive() {
-        let e = load(&["guard.omega=-1", "guard.omega_hat=nan"]).expect_err("invalid");
+        let e =
+            (load(&["guard.omega=-1", "guard.omega_hat=nan"]).expect_err("invalid")).to_string();
         assert!(e.contains("guard.omega: must be > 0, got -1"), "{e}");
         assert!(
             e.contains("guard.omega_hat: must be a finite number"),
             "{e}"
         );
-        let e = load(&["guard.speed=1"]).expect_err("unknown key");
+        let e = load(&["guard.speed=1"])
+            .expect_err("unknown key")
+            .to_string();
         assert!(e.contains("guard.speed"), "{e}");
     }
 }

@@ -80,7 +80,7 @@ pub fn exec(a: GenCmd) -> Result<(), Error> {
     attsync::options::tree(&p)?;
     // What `tree` refuses is the arguments (a duration `check` would
     // refuse, a tree too large for any horizon): invalid input, exit 2.
-    let g = tree(&p).map_err(|e| Error::Options(OptionError::Conflict(e)))?;
+    let g = tree(&p).map_err(|e| Error::Options(OptionError::Conflict(e.to_string())))?;
     if let Some(w) = &g.warning {
         eprintln!("warning: {w}");
     }
