@@ -7,10 +7,12 @@
 //! - [`wait`]: waiting strategies.
 //! - [`backpressure`]: how a publisher paces itself while a receiver is full.
 //! - [`args`]: the command line shared by the agent and leader binaries.
+//! - [`role`]: a configuration for the other role ([`RoleError`]).
 //! - [`AgentNode`]: the model ([`attitude::agent::Agent`]) behind the loop.
 
 pub mod args;
 pub mod backpressure;
+pub mod role;
 pub mod runtime;
 pub mod wait;
 
@@ -20,6 +22,7 @@ use iceoryx2::node::Node;
 use iceoryx2::service::Service;
 use msgs::Telemetry;
 use msgs::config::{NodeConfig, Role};
+pub use role::RoleError;
 /// Runs any [`Stepper`] (your own agent model) behind the node loop: the
 /// way to write a plug-in agent in Rust (see `examples/saturated_agent/`).
 pub use runtime::run as run_stepper;
@@ -35,12 +38,15 @@ pub struct AgentNode {
 
 impl AgentNode {
     /// Builds the agent of `cfg` (which must have an agent role).
-    pub fn from_config(cfg: &NodeConfig) -> Result<Self, String> {
+    ///
+    /// # Errors
+    /// [`RoleError::Leader`] if `cfg` is the leader's.
+    pub fn from_config(cfg: &NodeConfig) -> Result<Self, RoleError> {
         match &cfg.role {
             Role::Agent { model, initial } => Ok(Self {
                 agent: Agent::new((**model).clone(), *initial, cfg.dt),
             }),
-            Role::Leader { .. } => Err(format!("node {} is configured as the leader", cfg.id)),
+            Role::Leader { .. } => Err(RoleError::Leader(cfg.id)),
         }
     }
 }
@@ -88,6 +94,6 @@ pub fn run<S: Service>(
     cfg: &NodeConfig,
     shutdown: &AtomicBool,
 ) -> Result<(), NodeError> {
-    let mut a = AgentNode::from_config(cfg).map_err(NodeError::Protocol)?;
+    let mut a = AgentNode::from_config(cfg).map_err(|e| NodeError::Protocol(e.to_string()))?;
     runtime::run(node, cfg, &mut a, shutdown)
 }

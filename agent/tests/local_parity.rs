@@ -57,11 +57,13 @@ fn node(cfg: &NodeConfig) -> Result<(), NodeError> {
     let shutdown = AtomicBool::new(false);
     match cfg.role {
         Role::Leader { .. } => {
-            let mut l = LeaderNode::from_config(cfg).map_err(NodeError::Protocol)?;
+            let mut l =
+                LeaderNode::from_config(cfg).map_err(|e| NodeError::Protocol(e.to_string()))?;
             attsync_agent::runtime::run(&node, cfg, &mut l, &shutdown)
         }
         Role::Agent { .. } => {
-            let mut a = AgentNode::from_config(cfg).map_err(NodeError::Protocol)?;
+            let mut a =
+                AgentNode::from_config(cfg).map_err(|e| NodeError::Protocol(e.to_string()))?;
             attsync_agent::runtime::run(&node, cfg, &mut a, &shutdown)
         }
     }

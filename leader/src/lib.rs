@@ -4,7 +4,7 @@
 
 use attitude::network::Exchanged;
 use attitude::reference::Leader;
-use attsync_agent::{NodeError, Stepper};
+use attsync_agent::{NodeError, RoleError, Stepper};
 use iceoryx2::node::Node;
 use iceoryx2::service::Service;
 use msgs::Telemetry;
@@ -17,10 +17,13 @@ pub struct LeaderNode(Leader);
 
 impl LeaderNode {
     /// Builds the leader of `cfg` (which must have the leader role).
-    pub fn from_config(cfg: &NodeConfig) -> Result<Self, String> {
+    ///
+    /// # Errors
+    /// [`RoleError::Agent`] if `cfg` is an agent's.
+    pub fn from_config(cfg: &NodeConfig) -> Result<Self, RoleError> {
         match &cfg.role {
             Role::Leader { p, initial } => Ok(Self(Leader::new(*p, *initial, cfg.dt))),
-            Role::Agent { .. } => Err(format!("node {} is configured as an agent", cfg.id)),
+            Role::Agent { .. } => Err(RoleError::Agent(cfg.id)),
         }
     }
 }
@@ -54,6 +57,6 @@ pub fn run<S: Service>(
     cfg: &NodeConfig,
     shutdown: &AtomicBool,
 ) -> Result<(), NodeError> {
-    let mut l = LeaderNode::from_config(cfg).map_err(NodeError::Protocol)?;
+    let mut l = LeaderNode::from_config(cfg).map_err(|e| NodeError::Protocol(e.to_string()))?;
     attsync_agent::runtime::run(node, cfg, &mut l, shutdown)
 }

@@ -49,7 +49,7 @@ impl DelayedHost {
             Ok(()) => (DelayKind::Netem, None),
             Err(why) => {
                 let r = DelayRelay::start(SocketAddr::from((veth.root_addr, 0)), at, delay);
-                (DelayKind::Relay(why), Some(r))
+                (DelayKind::Relay(why.to_string()), Some(r))
             }
         };
         let endpoint = relay

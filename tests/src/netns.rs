@@ -93,7 +93,10 @@ impl Veth {
     /// that every packet across waits `delay` (a round trip twice that).
     /// `Err` with `tc`'s words if it refuses (a kernel built without
     /// `sch_netem`, as some VMs' are), neither end then delayed.
-    pub fn netem_delay(&self, delay: Duration) -> Result<(), String> {
+    ///
+    /// # Errors
+    /// [`NetemRefused`] with `tc`'s words.
+    pub fn netem_delay(&self, delay: Duration) -> Result<(), NetemRefused> {
         let d = format!("{}us", delay.as_micros());
         let netem = ["qdisc", "add", "dev"];
         let args = |dev: &str| {
@@ -112,9 +115,23 @@ impl Veth {
         let del = |dev: &str| ["qdisc", "del", "dev", dev, "root"].map(String::from);
         let _ = run(Command::new("tc").args(del(&self.root_if)));
         let _ = run(self.in_host("tc").args(del(&self.host_if)));
-        Err(String::from_utf8_lossy(&failed.stderr).trim().to_string())
+        Err(NetemRefused(
+            String::from_utf8_lossy(&failed.stderr).trim().to_string(),
+        ))
     }
 }
+
+/// `tc` refused the netem delay (its words on stderr).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NetemRefused(pub String);
+
+impl std::fmt::Display for NetemRefused {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for NetemRefused {}
 
 impl Drop for Veth {
     fn drop(&mut self) {

@@ -35,27 +35,25 @@ fn judge(t: &[f64], x: &[f64], tol: f64, th: &Thresholds) -> Verdict {
     let window = [t[start], t1];
     match evidence(t, x, start, th) {
         Ok(ev) => decide(&ev, tol, th),
-        Err(why) => Verdict::bare(Kind::Undecided, tol, window, why),
+        Err(why) => Verdict::bare(Kind::Undecided, tol, window, why.to_string()),
     }
 }
 
 /// What the window `start..` shows, or why it is too short to tell.
-fn evidence(t: &[f64], x: &[f64], start: usize, th: &Thresholds) -> Result<Evidence, String> {
+fn evidence(t: &[f64], x: &[f64], start: usize, th: &Thresholds) -> Result<Evidence, TooShort> {
     let (samples, window) = (t.len() - start, [t[start], t[t.len() - 1]]);
     let span = window[1] - window[0];
     if samples < th.min_samples.max(3) || span.is_nan() || span <= 0.0 {
         let need = th.min_samples;
-        return Err(format!("{samples} samples in the window, {need} needed"));
+        return Err(TooShort::Samples { samples, need });
     }
     let periods = oscillation::periods(&t[start..], &x[start..], th.oscillation_swing);
     let count = block_count(samples, window, periods, th);
     if count < th.min_blocks.max(3) {
         let need = th.min_blocks;
         return Err(match periods.signal {
-            Some(p) => format!(
-                "the {span:.3} s window holds too few periods ({p:.4} s) of the oscillation for {need} blocks"
-            ),
-            None => format!("{samples} samples are too few for {need} blocks"),
+            Some(period) => TooShort::Periods { span, period, need },
+            None => TooShort::Blocks { samples, need },
         });
     }
     let blocks = envelope::blocks(t, x, start, count);
@@ -67,6 +65,51 @@ fn evidence(t: &[f64], x: &[f64], start: usize, th: &Thresholds) -> Result<Evide
         window_max: blocks.iter().map(|b| b.max).fold(0.0, f64::max),
         before_max: x[..start].iter().copied().fold(0.0, f64::max),
     })
+}
+
+/// Why the window is too short to tell (the verdict's reason).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum TooShort {
+    /// Fewer samples than needed, or a window of no length.
+    Samples {
+        /// Samples in the window.
+        samples: usize,
+        /// `min_samples`.
+        need: usize,
+    },
+    /// Too few periods of the oscillation for the blocks.
+    Periods {
+        /// The window's length, s.
+        span: f64,
+        /// The oscillation's period, s.
+        period: f64,
+        /// `min_blocks`.
+        need: usize,
+    },
+    /// Too few samples for the blocks.
+    Blocks {
+        /// Samples in the window.
+        samples: usize,
+        /// `min_blocks`.
+        need: usize,
+    },
+}
+
+impl std::fmt::Display for TooShort {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            TooShort::Samples { samples, need } => {
+                write!(f, "{samples} samples in the window, {need} needed")
+            }
+            TooShort::Periods { span, period, need } => write!(
+                f,
+                "the {span:.3} s window holds too few periods ({period:.4} s) of the oscillation for {need} blocks"
+            ),
+            TooShort::Blocks { samples, need } => {
+                write!(f, "{samples} samples are too few for {need} blocks")
+            }
+        }
+    }
 }
 
 /// First sample of the trailing window `[t_end − f·(t_end − t₀), t_end]`.

@@ -48,13 +48,13 @@ impl Plan {
     }
 
     /// The steps of a `wait` run of `case` on `cores` cores, and a note if
-    /// shortened; `Err(reason)` if it is skipped.
+    /// shortened; [`Skipped`] if it is skipped.
     pub fn steps_for(
         &self,
         case: &Case,
         wait: WaitStrategy,
         cores: u32,
-    ) -> Result<(u64, String), String> {
+    ) -> Result<(u64, String), Skipped> {
         if wait != WaitStrategy::Spin || case.nodes <= cores {
             Ok((case.steps, String::new()))
         } else if case.nodes <= self.spin_max_nodes {
@@ -66,13 +66,29 @@ impl Plan {
                 ),
             ))
         } else {
-            Err(format!(
-                "{} (N = {}): spin skipped — {} busy-polling processes on {cores} cores \
-                 progress only when the scheduler preempts one (see the N = 8 spin rows)",
-                case.label, case.nodes, case.nodes
-            ))
+            Err(Skipped {
+                label: case.label.clone(),
+                nodes: case.nodes,
+                cores,
+            })
         }
     }
+}
+
+/// A spinning run of more processes than cores (and than
+/// `spin_max_nodes`): skipped, it would progress only by preemption.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{label} (N = {nodes}): spin skipped — {nodes} busy-polling processes on {cores} cores \
+     progress only when the scheduler preempts one (see the N = 8 spin rows)"
+)]
+pub(super) struct Skipped {
+    /// The case's label.
+    pub label: String,
+    /// Its nodes.
+    pub nodes: u32,
+    /// The cores.
+    pub cores: u32,
 }
 
 /// One scenario to measure.

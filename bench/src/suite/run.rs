@@ -313,7 +313,7 @@ impl<'a> Runner<'a> {
             let (steps, note) = match plan.steps_for(&case, wait, cores) {
                 Ok(x) => x,
                 Err(skipped) => {
-                    res.skipped.push(skipped);
+                    res.skipped.push(skipped.to_string());
                     continue;
                 }
             };

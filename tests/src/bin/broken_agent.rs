@@ -86,7 +86,7 @@ struct StateMsgV1 {
 
 /// `wrong-type`: open our state service with [`StateMsgV1`] (the settings
 /// of `msgs::open::state`); if we created it, hold it until start-up times out.
-fn wrong_type<S: Service>(node: &Node<S>, cfg: &NodeConfig) -> Result<(), String> {
+fn wrong_type<S: Service>(node: &Node<S>, cfg: &NodeConfig) -> Result<(), MainError> {
     let (name, l) = (names::state(&cfg.run, cfg.id), &cfg.limits);
     let (t, size) = ("attsync::StateMsgV1", std::mem::size_of::<StateMsgV1>());
     // Retry (as msgs::open does): two creators at once make one fail transiently.
@@ -105,18 +105,18 @@ fn wrong_type<S: Service>(node: &Node<S>, cfg: &NodeConfig) -> Result<(), String
         .open_or_create()
     {
         if e == incompatible || Instant::now() > give_up {
-            return Err(format!(
+            return Err(MainError::Setup(format!(
                 "cannot open service {name} with payload type {t} ({size} B): {e:?}"
-            ));
+            )));
         }
         std::thread::sleep(Duration::from_millis(5));
     }
     // We created it: every peer that opens it with attsync's type is refused.
     warn!(%name, size, "created the state service with payload type {t}");
     std::thread::sleep(Duration::from_secs_f64(cfg.start_timeout));
-    Err(format!(
+    Err(MainError::Setup(format!(
         "created {name} with the wrong payload type; nobody could connect"
-    ))
+    )))
 }
 
 fn main() -> ExitCode {
@@ -138,13 +138,14 @@ fn main() -> ExitCode {
             }
             // The first exchange from step 3 (skip-step) or 5 (nan) on.
             let from = match kind.as_str() {
-                "wrong-type" => return wrong_type(node, cfg).map_err(MainError::Setup),
+                "wrong-type" => return wrong_type(node, cfg),
                 "skip-step" => 3,
                 "nan" => 5,
                 _ => u64::MAX,
             };
             let at = Schedule::new(cfg.coupling, cfg.steps).first_exchange_from(from);
-            let mut agent = AgentNode::from_config(cfg).map_err(NodeError::Protocol)?;
+            let mut agent =
+                AgentNode::from_config(cfg).map_err(|e| NodeError::Protocol(e.to_string()))?;
             let (mut fault, shutdown) = (Fault { kind, at }, AtomicBool::new(false));
             Ok(attsync_agent::run_with(
                 node, cfg, &mut agent, &mut fault, &shutdown,
