@@ -59,10 +59,11 @@ impl Outcome {
         Self {
             peak_torques,
             steps,
-            failure: (diverged.is_some() || interrupted).then(|| match diverged {
-                Some(_) => Failure::Diverged(None),
-                None => Failure::Interrupted(None),
-            }),
+            failure: match (diverged, interrupted) {
+                (Some(_), _) => Some(Failure::Diverged(None)),
+                (None, true) => Some(Failure::Interrupted(None)),
+                (None, false) => None,
+            },
             diverged,
             links,
             pacing: Vec::new(),

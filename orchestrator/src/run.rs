@@ -332,10 +332,10 @@ fn drive(
         Some(d) => Some(Failure::Diverged(Some(
             d.message(net, loaded.resolved.stiffness.as_ref()),
         ))),
-        None => outcome.failure.map(|f| match interrupt.is_set() {
-            true => f.with_signal(interrupted_signal(interrupt)),
-            false => f,
-        }),
+        None if interrupt.is_set() => {
+            (outcome.failure).map(|f| f.with_signal(interrupted_signal(interrupt)))
+        }
+        None => outcome.failure,
     };
     let outcome = Outcome { failure, ..outcome };
     Ok(Driven { outcome, ..driven })

@@ -95,7 +95,7 @@ impl Veth {
     /// `sch_netem`, as some VMs' are), neither end then delayed.
     ///
     /// # Errors
-    /// [`NetemRefused`] with `tc`'s words.
+    /// `NetemRefused` with `tc`'s words.
     pub fn netem_delay(&self, delay: Duration) -> Result<(), NetemRefused> {
         let d = format!("{}us", delay.as_micros());
         let netem = ["qdisc", "add", "dev"];
