@@ -5,6 +5,8 @@
 //!   into the model's [`attitude::network::Network`].
 //! - [`run`]: engines and the run driver (progress, interruption).
 //! - [`outcome`]: how a run ended, the same [`outcome::Outcome`] from either engine.
+//! - [`failure`]: why a run stopped early ([`failure::Failure`]), carried to
+//!   `summary.json` and the exit code.
 //! - [`processes`]: the process-per-agent engine, phase by phase; the orchestrator's ports.
 //! - [`results`]: `errors.csv`, `summary.json`, `errors.svg`, atomic output.
 //! - [`sweep`]: one field over many values, and the bisection for the margin.

@@ -319,7 +319,7 @@ pub fn trial_alone(
     let trace = trace_of_run(out, &base)?;
     let end = match (&summary.diverged, &summary.incomplete_reason) {
         (Some(d), Some(why)) => End::Diverged(d.t, why.to_string()),
-        (_, Some(why)) => End::Failed(why.to_string()),
+        (_, Some(why)) => End::Failed(why.clone()),
         _ => End::Complete,
     };
     let result = classify(k, prepared.seed, end, &trace, &o.judging);

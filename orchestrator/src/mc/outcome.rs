@@ -3,6 +3,7 @@
 //! classification ([`classify`]) by the verdict (`docs/verdicts.md`), the
 //! same as `attsync run`'s.
 
+use crate::failure::Failure;
 use crate::results::summary::Settle;
 use crate::run::Judging;
 use attitude::engine::Snapshot;
@@ -79,8 +80,8 @@ pub enum End {
     Complete,
     /// A state left the envelope at `t` s (the run's message).
     Diverged(f64, String),
-    /// A node failed (the run's reason).
-    Failed(String),
+    /// A node failed (the run's failure).
+    Failed(Failure),
 }
 
 /// The largest errors over agents at each output sample of a run.
@@ -201,7 +202,7 @@ pub fn classify(trial: u64, seed: u64, end: End, trace: &Trace, judging: &Judgin
             Outcome::Diverging,
             Some(why),
         ),
-        End::Failed(why) => (None, Outcome::Failed, Some(why)),
+        End::Failed(why) => (None, Outcome::Failed, Some(why.to_string())),
     };
     let settle = if complete {
         Settle::of(&trace.t, &trace.att, &trace.angvel)
@@ -287,7 +288,7 @@ mod tests {
         let dead = classify(
             4,
             9,
-            End::Failed("agent-2 died".into()),
+            End::Failed(Failure::Recorded("agent-2 died".into())),
             &trace(&fast, &fast, 0.1),
             &judging(),
         );

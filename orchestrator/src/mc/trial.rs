@@ -162,7 +162,7 @@ pub fn run_processes(
         let stiffness = p.loaded.resolved.stiffness.as_ref();
         let end = match (outcome.diverged, outcome.failure) {
             (Some(d), _) => End::Diverged(d.step as f64 * net.dt, d.message(&net, stiffness)),
-            (None, Some(why)) => End::Failed(why.to_string()),
+            (None, Some(why)) => End::Failed(why),
             (None, None) => End::Complete,
         };
         let again =
