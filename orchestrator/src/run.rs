@@ -407,7 +407,7 @@ fn drive_processes(
     let max = opts.judging.max_steps(net.steps, net.dt);
     let mut process_opts = opts.processes.clone();
     process_opts.plugins = loaded.resolved.plugins.clone();
-    process_opts.hosts = plan(loaded, opts)?;
+    process_opts.hosts = plan(loaded, opts)?.map(|p| std::sync::Arc::new(p) as _);
     let mut chunks = 0;
     // Without plug-ins the in-process engine finds the final horizon
     // (bit-identical lockstep): the processes run once, to it.

@@ -27,13 +27,14 @@ impl Session<'_> {
         None
     }
 
-    /// A lost host, a host's failure, or a node on a host that exited
-    /// before it was done (named with its host, status and log's end).
-    pub(super) fn remote_ended_early(&mut self) -> Result<Option<Failure>, Failure> {
-        let Some(r) = &self.remote else {
-            return Ok(None);
-        };
-        for e in r.check()? {
+    /// A site's failure (a lost host), or a node placed elsewhere that
+    /// exited before it was done (named with its host, status and log's end).
+    pub(super) fn ended_elsewhere(&mut self) -> Result<Option<Failure>, Failure> {
+        let mut ended = Vec::new();
+        for site in &mut self.sites {
+            ended.extend(site.ended()?);
+        }
+        for e in ended {
             let Some(slot) = self.nodes.slots.iter().find(|s| s.id == e.id) else {
                 continue;
             };

@@ -35,6 +35,7 @@ pub mod placement;
 pub mod ports;
 pub mod reaper;
 mod shutdown;
+pub mod site;
 mod startup;
 pub mod supervise;
 
@@ -69,8 +70,9 @@ pub struct ProcessOptions {
     pub plugins: Vec<Plugin>,
     /// Where the node processes run ([`placement::Placement`]).
     pub placement: placement::Placement,
-    /// Nodes placed on other hosts (`run --hosts`), if any.
-    pub hosts: Option<crate::remote::Plan>,
+    /// Where nodes run other than here (`run --hosts`: the hosts' plan), if
+    /// anywhere.
+    pub hosts: Option<std::sync::Arc<dyn site::Elsewhere>>,
 }
 
 impl Default for ProcessOptions {
@@ -101,7 +103,7 @@ pub enum ProcessError {
     Open(#[from] OpenError),
     /// A host of the run cannot be reached or used.
     #[error(transparent)]
-    Remote(#[from] crate::remote::RemoteError),
+    Remote(#[from] crate::failure::RemoteError),
     /// A file could not be written.
     #[error("{path}: {source}")]
     Io {
@@ -126,9 +128,9 @@ struct Session<'a> {
     interrupt: &'a AtomicBool,
     /// `attsync-agent` and `attsync-leader`.
     binaries: (PathBuf, PathBuf),
-    /// The hosts of a run placed over several machines (dropped before the
-    /// ports: its bridges use the namespace).
-    remote: Option<crate::remote::Remote>,
+    /// Where nodes run other than here (dropped before the ports: their
+    /// bridges use the namespace).
+    sites: Vec<Box<dyn site::Site>>,
     /// Dropped before the supervisor: the namespace goes first, as it always did.
     ports: Ports,
     sup: Supervisor,
@@ -155,11 +157,11 @@ pub fn run(
         "processes: ports open, spawning"
     );
     s.spawn_nodes()?;
-    let remote_started = s.start_remote();
+    let sites_started = s.start_sites();
     let graph = local_graph(net, s.sup.indices());
     let placer = placement::Placer::start(opts.placement, s.sup.pids().to_vec(), &graph);
     tracing::debug!("processes: spawned, waiting for Ready");
-    let failure = remote_started
+    let failure = sites_started
         .and_then(|()| s.await_ready())
         .and_then(|()| {
             tracing::debug!("processes: all ready, Start");

@@ -20,14 +20,14 @@ impl Session<'_> {
         if failure.is_some() {
             self.sup.kill_all();
             let _ = self.sup.wait_all(KILL_TIMEOUT);
-            if let Some(r) = self.remote.as_mut() {
-                r.finish(true, self.logs);
+            for site in &mut self.sites {
+                site.finish(true, self.logs);
             }
             return failure;
         }
         let _ = self.ports.stop();
-        if let Some(r) = &self.remote {
-            let _ = r.control(ControlMsg::new(ControlCommand::Stop));
+        for site in &self.sites {
+            let _ = site.control(ControlMsg::new(ControlCommand::Stop));
         }
         let mut bad: Vec<String> = (self.sup.wait_all(STOP_TIMEOUT).iter())
             .filter(|e| !matches!(&e.status, Ok(s) if s.success()))
@@ -36,8 +36,8 @@ impl Session<'_> {
                 format!("{label}: {}", describe(&e.status))
             })
             .collect();
-        if let Some(r) = self.remote.as_mut() {
-            for e in r.finish(false, self.logs) {
+        for site in &mut self.sites {
+            for e in site.finish(false, self.logs) {
                 let label = (self.nodes.slots.iter())
                     .find(|s| s.id == e.id)
                     .map_or_else(|| format!("host {}", e.host), |s| s.label.clone());

@@ -5,6 +5,7 @@
 use super::collect::{Collector, NodeSlot};
 use super::configs::{node_configs, node_id, node_label, node_name, plugin_of};
 use super::namespace::{self, Namespace};
+use super::site::{Setup, SetupNode};
 use super::supervise::{Launch, Supervisor, find_binaries};
 use super::{ProcessError, ProcessOptions, Session, io_at};
 use crate::failure::Failure;
@@ -38,13 +39,13 @@ impl<'a> Session<'a> {
         let start_timeout = Duration::from_secs_f64(opts.start_timeout);
         let ports = super::Ports::open(ns, "orchestrator", &Limits::of(net), &ids, start_timeout)?;
         let sup = Supervisor::new().map_err(io_at(Path::new("tokio runtime")))?;
-        let remote = (opts.hosts.as_ref())
-            .map(|plan| crate::remote::Remote::connect(plan, ports.run()))
-            .transpose()?;
+        let sites: Vec<_> = (opts.hosts.iter())
+            .map(|e| e.open(ports.run()))
+            .collect::<Result<_, _>>()?;
         let slots = (0..n_nodes)
             .map(|i| {
                 let mut label = node_label(net, &opts.plugins, i);
-                if let Some(h) = remote.as_ref().and_then(|r| r.host_of(ids[i])) {
+                if let Some(h) = sites.iter().find_map(|s| s.host_of(ids[i])) {
                     label = format!("{label} on host {h}");
                 }
                 NodeSlot::new(node_name(net, i), label, ids[i])
@@ -56,7 +57,7 @@ impl<'a> Session<'a> {
             logs,
             interrupt,
             binaries,
-            remote,
+            sites,
             ports,
             sup,
             nodes: Collector::new(slots),
@@ -76,7 +77,7 @@ impl<'a> Session<'a> {
         let (agent_bin, leader_bin) = self.binaries.clone();
         let configs = node_configs(self.net, self.ports.run(), self.ports.dir(), self.opts);
         for (i, c) in configs.iter().enumerate() {
-            if self.remote.as_ref().is_some_and(|r| r.places(c.id)) {
+            if self.sites.iter().any(|s| s.places(c.id)) {
                 continue;
             }
             let file = (self.ports.dir()).join(crate::results::layout::node_config_file(c.id));
@@ -162,40 +163,34 @@ impl<'a> Session<'a> {
             Some(_) => ControlMsg::start_at(msgs::unix_ns_now() + REALTIME_LEAD.as_nanos() as u64),
             None => ControlMsg::new(ControlCommand::Start),
         };
-        if let Some(r) = &self.remote {
-            r.control(msg)?;
+        for site in &self.sites {
+            site.control(msg)?;
         }
         (self.ports).send(msg).map_err(|_| Failure::StartNotSent)
     }
 
-    /// Hands each host its nodes and starts the bridges of a run placed
-    /// over hosts (nothing otherwise).
-    pub(super) fn start_remote(&mut self) -> Result<(), Failure> {
-        let Some(remote) = self.remote.as_mut() else {
+    /// Starts the nodes placed elsewhere, on every site (none for a run on
+    /// this machine).
+    pub(super) fn start_sites(&mut self) -> Result<(), Failure> {
+        if self.sites.is_empty() {
             return Ok(());
-        };
+        }
         let configs = node_configs(self.net, self.ports.run(), self.ports.dir(), self.opts);
-        let ns = crate::remote::local::LocalNs {
-            run: self.ports.run().to_string(),
-            dir: self.ports.dir().to_owned(),
+        let setup = Setup {
+            run: self.ports.run(),
+            dir: self.ports.dir(),
             limits: Limits::of(self.net),
             stage_timeout: Duration::from_secs_f64(self.opts.stage_timeout),
             realtime: self.opts.realtime.is_some(),
+            configs: &configs,
+            nodes: (0..configs.len())
+                .map(|i| SetupNode {
+                    name: node_name(self.net, i),
+                    plugin: plugin_of(self.net, &self.opts.plugins, i),
+                })
+                .collect(),
         };
-        let (net, opts) = (self.net, self.opts);
-        let node = |id: u32| {
-            let i = (0..=net.agents.len())
-                .find(|&i| node_id(net, i) == id)
-                .unwrap_or(0);
-            let plugin =
-                plugin_of(net, &opts.plugins, i).map(|p| crate::remote::wire::PluginCommand {
-                    command: p.command.clone(),
-                    env: p.env.clone(),
-                    dir: p.dir.clone(),
-                });
-            (node_name(net, i), plugin)
-        };
-        Ok(remote.start(&ns, &configs, &node)?)
+        self.sites.iter_mut().try_for_each(|s| s.start(&setup))
     }
 
     /// Fails if a node has ended before it was done, or on an interrupt.
@@ -203,7 +198,7 @@ impl<'a> Session<'a> {
         if let Some(f) = self.ended_early() {
             return Err(f);
         }
-        if let Some(f) = self.remote_ended_early()? {
+        if let Some(f) = self.ended_elsewhere()? {
             return Err(f);
         }
         if self.interrupt.load(Ordering::Relaxed) {

@@ -11,16 +11,17 @@ use super::keys;
 use super::local::{LocalNs, Shared};
 use super::pieces;
 use super::plan::{Plan, links};
-pub use super::remote_error::RemoteError;
 use super::telemetry::{self, End, TelemetryThread};
 use super::wire::{
-    Answer, EndReply, EndRequest, HostEvent, NodeEnd, RemoteNode, RunOffer, RunRequest,
+    Answer, EndReply, EndRequest, HostEvent, NodeEnd, PluginCommand, RemoteNode, RunOffer,
+    RunRequest,
 };
 use super::zconfig;
+pub use crate::failure::RemoteError;
 use crate::processes::node_log::cut_note;
+use crate::processes::site::{Setup, SiteExit};
 use msgs::ControlMsg;
 use msgs::bytes::Bytes;
-use msgs::config::NodeConfig;
 use std::io::Write;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -36,21 +37,6 @@ use zenoh::sample::Sample;
 pub const REACH_TIMEOUT: Duration = Duration::from_secs(5);
 /// Longest wait for a host to start its nodes, or to end them.
 const ANSWER_TIMEOUT: Duration = Duration::from_secs(30);
-
-/// A node's exit on a host, as the host reported it.
-#[derive(Debug, Clone)]
-pub struct RemoteExit {
-    /// The node's id.
-    pub id: u32,
-    /// The host's name.
-    pub host: String,
-    /// Its exit, described.
-    pub status: String,
-    /// It exited with code 0.
-    pub clean: bool,
-    /// The last lines of its log.
-    pub tail: String,
-}
 
 /// The orchestrator's connection to the hosts of one run. Dropping it stops
 /// the bridges, then withdraws the run's token (the hosts clean up).
@@ -173,15 +159,17 @@ impl Remote {
         }
     }
 
-    /// Starts the local bridges and telemetry sinks in `ns`, then hands each
-    /// host its nodes (`configs` of every node; `names`, `plugins` by node id).
-    pub fn start(
-        &mut self,
-        ns: &LocalNs,
-        configs: &[NodeConfig],
-        node: &dyn Fn(u32) -> (String, Option<super::wire::PluginCommand>),
-    ) -> Result<(), RemoteError> {
-        let links = links(configs, &self.plan);
+    /// Starts the local bridges and telemetry sinks in the run's namespace,
+    /// then hands each host its nodes.
+    pub fn start(&mut self, setup: &Setup<'_>) -> Result<(), RemoteError> {
+        let ns = &LocalNs {
+            run: setup.run.to_string(),
+            dir: setup.dir.to_owned(),
+            limits: setup.limits,
+            stage_timeout: setup.stage_timeout,
+            realtime: setup.realtime,
+        };
+        let links = links(setup.configs, &self.plan);
         let (s, run) = (&self.session, self.run.as_str());
         self.bridges = Some(Bridges::start(
             s,
@@ -202,15 +190,12 @@ impl Remote {
             let req = RunRequest {
                 run: self.run.clone(),
                 host: h.name.clone(),
-                nodes: (configs.iter())
-                    .filter(|c| h.nodes.contains(&c.id))
-                    .map(|c| {
-                        let (name, plugin) = node(c.id);
-                        RemoteNode {
-                            name,
-                            config: c.clone(),
-                            plugin,
-                        }
+                nodes: (setup.configs.iter().zip(&setup.nodes))
+                    .filter(|(c, _)| h.nodes.contains(&c.id))
+                    .map(|(c, n)| RemoteNode {
+                        name: n.name.clone(),
+                        config: c.clone(),
+                        plugin: n.plugin.map(PluginCommand::of),
                     })
                     .collect(),
                 links: (links.iter())
@@ -265,7 +250,7 @@ impl Remote {
 
     /// A lost host, a host's failure, or a bridge's: the run cannot go on.
     /// `Ok` carries the node exits the hosts reported since the last call.
-    pub fn check(&self) -> Result<Vec<RemoteExit>, RemoteError> {
+    pub fn check(&self) -> Result<Vec<SiteExit>, RemoteError> {
         if let Some(h) = self.lost_host() {
             let nodes: Vec<String> = (self.plan.hosts.iter())
                 .find(|p| p.name == h)
@@ -291,7 +276,7 @@ impl Remote {
                     status,
                     clean,
                     tail,
-                }) => exits.push(RemoteExit {
+                }) => exits.push(SiteExit {
                     id,
                     host,
                     status,
@@ -318,7 +303,7 @@ impl Remote {
 
     /// Ends the run on every host that started it (`kill`: at once), writes
     /// each node's log into `logs`, and returns the exits that were not clean.
-    pub fn finish(&mut self, kill: bool, logs: &Path) -> Vec<RemoteExit> {
+    pub fn finish(&mut self, kill: bool, logs: &Path) -> Vec<SiteExit> {
         let mut bad = Vec::new();
         let lost = self.lost_host();
         let mut pending = Vec::new();
@@ -344,7 +329,7 @@ impl Remote {
                 .ok()
                 .and_then(|b| serde_json::from_slice(&b).ok());
             let Some(reply) = reply else {
-                bad.push(RemoteExit {
+                bad.push(SiteExit {
                     id: u32::MAX,
                     host: name.clone(),
                     status: "did not report how its nodes ended".into(),
@@ -357,7 +342,7 @@ impl Remote {
                 let file = logs.join(crate::results::layout::node_log_file(&node_name(n.id)));
                 let _ = write_log(&file, &name, &n);
                 if !n.clean {
-                    bad.push(RemoteExit {
+                    bad.push(SiteExit {
                         id: n.id,
                         host: name.clone(),
                         status: n.status,

@@ -28,14 +28,14 @@ pub mod link;
 pub mod local;
 pub mod pieces;
 pub mod plan;
-pub mod remote_error;
+mod site;
 pub mod telemetry;
 pub mod wire;
 pub mod zconfig;
 
+pub use crate::failure::RemoteError;
 pub use client::Remote;
 pub use plan::{Plan, PlannedHost};
-pub use remote_error::RemoteError;
 
 use serde::{Deserialize, Serialize};
 use std::fmt;

@@ -31,6 +31,18 @@ pub struct PluginCommand {
     pub dir: PathBuf,
 }
 
+impl PluginCommand {
+    /// The command of plug-in `p`, as a host starts it.
+    #[must_use]
+    pub fn of(p: &crate::scenario::plugin::Plugin) -> Self {
+        Self {
+            command: p.command.clone(),
+            env: p.env.clone(),
+            dir: p.dir.clone(),
+        }
+    }
+}
+
 /// One node's states towards one other side: the receivers there.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct StateLink {

@@ -1,5 +1,5 @@
 //! [`RemoteError`]: why the orchestrator's side of a run placed over hosts
-//! ([`super::Remote`]) could not connect, start, relay or go on.
+//! ([`crate::remote::Remote`]) could not connect, start, relay or go on.
 
 use thiserror::Error;
 
@@ -12,7 +12,7 @@ pub enum RemoteError {
     /// The Zenoh session could not be configured or opened (its text).
     #[error("{0}")]
     Session(String),
-    /// A host did not answer its ping within [`super::client::REACH_TIMEOUT`].
+    /// A host did not answer its ping within [`crate::remote::client::REACH_TIMEOUT`].
     #[error(
         "host {name} ({endpoint}) is unreachable: no answer within {seconds} s; is \
          `attsync host --name {name} --listen {endpoint}` running there, and its port open?"

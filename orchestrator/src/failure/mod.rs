@@ -3,7 +3,9 @@
 //! (`summary.json` `incomplete_reason`, its [`Display`](std::fmt::Display)
 //! text) and to the exit code ([`Failure::exit_code`]).
 
-use crate::remote::RemoteError;
+mod host;
+
+pub use host::RemoteError;
 use std::fmt;
 
 /// Why a run stopped early. Its text is `summary.json`'s `incomplete_reason`.
