@@ -680,7 +680,7 @@ fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), OptionError> 
 /// process engine's warnings.
 fn check_capacity(loaded: &Loaded, opts: &RunOptions) -> Result<(), CapacityError> {
     let need = Need::of(&loaded.resolved.network, opts.processes.wait);
-    let host = Host::read(&processes::namespace::base_dir());
+    let host = Host::read(&crate::launch::namespace::base_dir());
     match opts.engine {
         Engine::Processes => {
             for warning in capacity::processes(&host, &need)? {

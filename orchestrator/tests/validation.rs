@@ -712,7 +712,7 @@ fn duration_must_be_a_positive_multiple_of_dt() {
         Path::new(FILE),
         BASE,
         &sets,
-        attsync::options::StiffnessCheck::Warn,
+        attsync::scenario::StiffnessCheck::Warn,
     )
     .unwrap_or_else(|e| panic!("expected a valid scenario, got:\n{e}"));
     assert_eq!(l.resolved.network.steps, 3);

@@ -14,7 +14,6 @@ use super::trial::{Base, Prepared, Ran, run_in_process, run_processes};
 use crate::interrupt::Interrupt;
 use crate::options::OptionError;
 use crate::processes::capacity::{self, Host, Need};
-use crate::processes::{self};
 use crate::results::layout;
 use crate::results::staging::Staging;
 use crate::run::{Engine, RunOptions};
@@ -79,7 +78,7 @@ pub fn load_base(o: &McOptions) -> Result<Base, McError> {
 /// `jobs` of them); logs the process engine's warnings.
 fn check_capacity(base: &Base, o: &McOptions) -> Result<(), McError> {
     let need = Need::of(&base.loaded.resolved.network, o.processes.wait);
-    let host = Host::read(&processes::namespace::base_dir());
+    let host = Host::read(&crate::launch::namespace::base_dir());
     match o.engine {
         Engine::Processes => {
             for warning in capacity::processes(&host, &need)? {
@@ -257,7 +256,7 @@ fn write_files(
     let ids: Vec<u32> = (base.loaded.scenario.agents.iter()).map(|a| a.id).collect();
     let mut initial = format!("{}\n", report::INITIAL_HEADER);
     for r in results {
-        let draws = base.dispersion.draw(&mut super::trial_rng(r.seed));
+        let draws = super::draws::draw(&base.dispersion, &mut super::trial_rng(r.seed));
         report::initial_rows(&mut initial, r.trial, &ids, &base.dispersion, &draws);
     }
     write(files.initial(), &initial)?;
@@ -361,7 +360,7 @@ pub fn run_command(o: &McOptions, p: &Prepared) -> String {
         super::draws::shell_quote(&o.scenario.display().to_string()),
         o.engine.name()
     );
-    if o.stiffness == crate::options::StiffnessCheck::Warn {
+    if o.stiffness == crate::scenario::StiffnessCheck::Warn {
         c += " --no-stiffness-check";
     }
     for s in o.set.iter().chain(&p.overrides) {

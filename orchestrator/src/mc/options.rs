@@ -1,8 +1,9 @@
 //! [`McOptions`]: what `attsync mc` runs and how.
 
-use crate::options::{self, OptionError, StiffnessCheck};
+use crate::options::{self, OptionError};
 use crate::processes::ProcessOptions;
 use crate::run::Engine;
+use crate::scenario::StiffnessCheck;
 use std::path::PathBuf;
 
 /// Default `--tolerance`: the largest `|Rᵢ R₀ᵀ|_I` over agents below it and

@@ -3,8 +3,8 @@
 //! waited for ([`Collector::blame`]), put first in the failure's text.
 
 use super::collect::Collector;
-use super::supervise::{describe, tail};
 use super::{Failure, Session};
+use crate::launch::supervise::{describe, tail};
 use std::time::{Duration, Instant};
 
 impl Session<'_> {

@@ -2,8 +2,8 @@
 //! (a node that does not exit cleanly fails the run); after a failure, every
 //! node killed.
 
-use super::supervise::describe;
 use super::{Failure, Session};
+use crate::launch::supervise::describe;
 use msgs::{ControlCommand, ControlMsg};
 use std::time::Duration;
 

@@ -4,9 +4,9 @@
 
 use super::collect::{Collector, NodeSlot};
 use super::configs::{node_configs, node_id, node_label, node_name, plugin_of};
-use super::namespace::{self, Namespace};
-use super::supervise::{Launch, Supervisor, find_binaries};
 use super::{Failure, ProcessError, ProcessOptions, Session, io_at};
+use crate::launch::namespace::{self, Namespace};
+use crate::launch::supervise::{Launch, Supervisor, find_binaries};
 use attitude::network::Network;
 use iceoryx2::service::port_factory::PortFactory;
 use msgs::{ControlCommand, ControlMsg, Limits};

@@ -16,7 +16,7 @@ use super::wire::{
     Answer, EndReply, EndRequest, HostEvent, NodeEnd, RemoteNode, RunOffer, RunRequest,
 };
 use super::zconfig;
-use crate::processes::node_log::cut_note;
+use crate::launch::node_log::cut_note;
 use msgs::ControlMsg;
 use msgs::bytes::Bytes;
 use msgs::config::NodeConfig;

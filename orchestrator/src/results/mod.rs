@@ -30,6 +30,7 @@ pub mod plot;
 pub mod staging;
 pub mod states;
 pub mod summary;
+pub mod until;
 
 use attitude::engine::Snapshot;
 use attitude::metrics::{Errors, errors};

@@ -26,11 +26,12 @@ pub use files::{CSV_HEADER, table};
 pub use margin::{LinearMargin, MarginResult};
 
 use crate::interrupt::Interrupt;
-use crate::options::{self, OptionError, StiffnessCheck};
+use crate::options::{self, OptionError};
 use crate::results::layout::SweepLayout;
 use crate::results::staging::Staging;
 use crate::results::summary::Settle;
 use crate::run::{Engine, RunError, RunOptions, run};
+use crate::scenario::StiffnessCheck;
 use crate::scenario::{self, Loaded, ScenarioError};
 use attsync_verdict::{Kind, Verdict};
 use std::path::{Path, PathBuf};

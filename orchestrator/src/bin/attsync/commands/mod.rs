@@ -110,7 +110,7 @@ pub struct ScenarioArgs {
 impl ScenarioArgs {
     /// The scenario with its overrides, validated (`check`: what to do with
     /// a step beyond RK4's stable one, `--no-stiffness-check`).
-    pub fn load(&self, check: attsync::options::StiffnessCheck) -> Result<Loaded, Error> {
+    pub fn load(&self, check: attsync::scenario::StiffnessCheck) -> Result<Loaded, Error> {
         Ok(scenario::load_with(
             &self.scenario,
             &self.overrides.set,
