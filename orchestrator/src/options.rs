@@ -15,6 +15,8 @@
 //! largest stable step (`docs/stiffness.md`) into a warning.
 
 use attitude::network::Network;
+use clap::ValueEnum;
+use msgs::config::WaitStrategy;
 use thiserror::Error;
 
 /// Longest duration an option may give, s (one day: a wait past it is a
@@ -28,6 +30,31 @@ pub const MAX_REALTIME: f64 = 1e6;
 /// Most bisection iterations (each halves the bracket: 64 reach f64's
 /// resolution of any bracket).
 pub const MAX_BISECT: u32 = 64;
+
+/// `--wait` (`run`, `sweep`, `mc`, `verify`, and the bench): how a node
+/// waits for its inputs.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum WaitArg {
+    /// Busy-poll.
+    Spin,
+    /// Poll with sched_yield.
+    Yield,
+    /// Sleep on iceoryx2 events (1 ms slices).
+    Block,
+    /// Yield a while (≤ 200 polls, 2 ms), then block; block at once on a busy machine.
+    Adaptive,
+}
+
+impl From<WaitArg> for WaitStrategy {
+    fn from(w: WaitArg) -> Self {
+        match w {
+            WaitArg::Spin => WaitStrategy::Spin,
+            WaitArg::Yield => WaitStrategy::Yield,
+            WaitArg::Block => WaitStrategy::Block,
+            WaitArg::Adaptive => WaitStrategy::Adaptive,
+        }
+    }
+}
 
 /// An option that cannot be used.
 #[derive(Debug, Clone, PartialEq, Error)]

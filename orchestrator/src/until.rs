@@ -19,8 +19,8 @@
 
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
-use crate::results::Series;
 pub use crate::results::until::{Stopped, UntilSummary};
+use crate::results::{Series, nan_max};
 use attitude::engine::{InProcess, Snapshot};
 use attitude::metrics::errors;
 use attitude::network::Network;
@@ -120,13 +120,8 @@ pub fn largest_attitude_error(series: &[Series]) -> (Vec<f64>, Vec<f64>) {
     };
     let x = (0..first.t.len())
         .map(|k| {
-            series.iter().fold(0.0_f64, |m, s| {
-                let e = s.att.get(k).copied().unwrap_or(f64::NAN);
-                if m.is_nan() || e.is_nan() {
-                    f64::NAN
-                } else {
-                    m.max(e)
-                }
+            (series.iter()).fold(0.0_f64, |m, s| {
+                nan_max(m, s.att.get(k).copied().unwrap_or(f64::NAN))
             })
         })
         .collect();
@@ -153,16 +148,10 @@ pub fn settled_horizon(
         let diverged = engine.run_until(
             |_, _, _| (),
             |snap: &Snapshot<'_>, _: &[()]| {
-                let largest = snap.agents.iter().fold(0.0_f64, |m, a| {
-                    let e = errors(a, snap.leader, false).att;
-                    if m.is_nan() || e.is_nan() {
-                        f64::NAN
-                    } else {
-                        m.max(e)
-                    }
+                let largest = (snap.agents.iter()).fold(0.0_f64, |m, a| {
+                    nan_max(m, errors(a, snap.leader, false).att)
                 });
-                let at = crate::results::fmt_time(snap.step, net.dt);
-                t.push(at.parse().expect("fmt_time prints a number"));
+                t.push(crate::results::sample_time(snap.step, net.dt));
                 x.push(largest);
                 !interrupt.is_set()
             },

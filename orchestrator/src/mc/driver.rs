@@ -7,21 +7,20 @@
 use super::dispersion::Dispersion;
 use super::error::{McError, io_at};
 use super::options::McOptions;
-use super::outcome::{End, Trace, TrialResult, classify, nan_max};
+use super::outcome::{End, Trace, TrialResult, classify};
 use super::plot;
 use super::report::{self, McSummary};
 use super::trial::{Base, Prepared, Ran, run_in_process, run_processes};
 use crate::interrupt::Interrupt;
 use crate::options::OptionError;
+use crate::pool::Flow;
 use crate::processes::capacity::{self, Host, Need};
 use crate::results::layout;
+use crate::results::nan_max;
 use crate::results::staging::Staging;
 use crate::run::{Engine, RunOptions};
 use crate::scenario::{ScenarioError, input};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::Path;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 /// A finished Monte Carlo.
@@ -184,61 +183,30 @@ fn one(
 }
 
 /// Trials `0..o.trials` on `o.jobs` workers; the results by index (those
-/// an interrupt prevented are missing).
+/// an interrupt prevented are missing). The first failed trial (by index)
+/// stops the pool and is the error.
 fn run_pool(
     base: &Base,
     o: &McOptions,
     dir: &Path,
     interrupt: &Interrupt,
 ) -> Result<Vec<TrialResult>, McError> {
-    let next = AtomicU64::new(0);
-    let abort = AtomicBool::new(false);
-    let slots: Mutex<Vec<Option<TrialResult>>> = Mutex::new(vec![None; o.trials as usize]);
-    let error: Mutex<Option<McError>> = Mutex::new(None);
-    let bar = progress_bar(o.progress, o.trials);
-    let workers = (o.jobs as u64).min(o.trials).max(1);
-    std::thread::scope(|s| {
-        for _ in 0..workers {
-            s.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    if k >= o.trials || interrupt.is_set() || abort.load(Ordering::Relaxed) {
-                        return;
-                    }
-                    match one(base, o, k, dir, interrupt) {
-                        Ok(Ran::Done(r)) => slots.lock().expect("lock")[k as usize] = Some(r),
-                        Ok(Ran::Interrupted) => return,
-                        Err(e) => {
-                            abort.store(true, Ordering::Relaxed);
-                            error.lock().expect("lock").get_or_insert(e);
-                            return;
-                        }
-                    }
-                    bar.inc(1);
-                }
-            });
-        }
-    });
+    let bar = crate::progress::of_jobs(o.progress, o.trials, "trials");
+    let ran = crate::pool::run(
+        o.trials as usize,
+        o.jobs,
+        || interrupt.is_set(),
+        |k| match one(base, o, k as u64, dir, interrupt) {
+            Ok(Ran::Done(r)) => {
+                bar.inc(1);
+                Flow::Next(Ok(r))
+            }
+            Ok(Ran::Interrupted) => Flow::Stop(None),
+            Err(e) => Flow::Stop(Some(Err(e))),
+        },
+    );
     bar.finish_and_clear();
-    if let Some(e) = error.into_inner().expect("lock") {
-        return Err(e);
-    }
-    let results: Vec<TrialResult> = slots
-        .into_inner()
-        .expect("lock")
-        .into_iter()
-        .flatten()
-        .collect();
-    Ok(results)
-}
-
-fn progress_bar(enabled: bool, trials: u64) -> ProgressBar {
-    if !enabled {
-        return ProgressBar::hidden();
-    }
-    let style = ProgressStyle::with_template("{bar:40} {pos}/{len} trials  {per_sec}  eta {eta}")
-        .expect("valid template");
-    ProgressBar::new(trials).with_style(style)
+    ran.into_iter().flatten().collect()
 }
 
 /// `trials.csv`, `initial.csv` (draws recomputed from each trial's seed),

@@ -16,12 +16,12 @@ mod view;
 use attsync::Error;
 use attsync::hosts::Hosts;
 use attsync::interrupt::Interrupt;
+pub use attsync::options::WaitArg;
 use attsync::processes::ProcessOptions;
 use attsync::processes::placement::Placement;
 use attsync::run::Engine;
 use attsync::scenario::{self, Loaded};
 use clap::{Subcommand, ValueEnum};
-use msgs::config::WaitStrategy;
 use std::path::{Path, PathBuf};
 
 /// The subcommands.
@@ -234,30 +234,6 @@ impl EngineArgs {
             realtime,
             placement: self.placement,
             ..ProcessOptions::default()
-        }
-    }
-}
-
-/// `--wait`.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum WaitArg {
-    /// Busy-poll.
-    Spin,
-    /// Poll with sched_yield.
-    Yield,
-    /// Sleep on iceoryx2 events (1 ms slices).
-    Block,
-    /// Yield a while (≤ 200 polls, 2 ms), then block; block at once on a busy machine.
-    Adaptive,
-}
-
-impl From<WaitArg> for WaitStrategy {
-    fn from(w: WaitArg) -> Self {
-        match w {
-            WaitArg::Spin => WaitStrategy::Spin,
-            WaitArg::Yield => WaitStrategy::Yield,
-            WaitArg::Block => WaitStrategy::Block,
-            WaitArg::Adaptive => WaitStrategy::Adaptive,
         }
     }
 }
