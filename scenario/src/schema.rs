@@ -1,5 +1,5 @@
 //! The scenario file format (TOML), as serde types. Unknown keys are
-//! rejected everywhere. See README.md § Scenario format.
+//! rejected everywhere. See `docs/scenarios.md`.
 
 use attitude::control::ControlLaw;
 use serde::{Deserialize, Serialize};
