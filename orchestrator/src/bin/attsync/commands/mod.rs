@@ -163,7 +163,8 @@ impl UntilArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct HostsArgs {
     /// Spread the nodes over machines as this placement file says
-    /// (HOSTS.toml: [[host]] name, endpoint, agents, leader; docs/hosts.md); nodes on no host run on this machine. Processes engine.
+    /// (HOSTS.toml: [[host]] name, endpoint, agents, leader; docs/hosts.md);
+    /// nodes on no host run on this machine. Processes engine.
     #[arg(long, value_name = "HOSTS.toml")]
     pub hosts: Option<PathBuf>,
     /// With --hosts: the lab's CA certificate (PEM), instead of the hosts
