@@ -12,7 +12,7 @@
 use attitude::engine::InProcess;
 use attitude::network::{AgentState, Network};
 use attitude::reference::LeaderState;
-use attsync::processes::namespace::Namespace;
+use attsync::launch::namespace::Namespace;
 use attsync::processes::{ProcessOptions, node_configs};
 use attsync_agent::{AgentNode, NodeError};
 use attsync_leader::LeaderNode;

@@ -1,4 +1,4 @@
-//! Erratum 1 of `NOTES.md`: the signs of `Σᵢ` (eq. `sigmai`) and `Γᵢ`
+//! Erratum 1 of `docs/paper.md`: the signs of `Σᵢ` (eq. `sigmai`) and `Γᵢ`
 //! (eq. `gammai`).
 //!
 //! With `R̄ = R̂ᵀR`, `v = R̄ᵀω̂` and `ω̄ = ω − v`, differentiating along the

@@ -459,7 +459,7 @@ fn jitter_never_lets_an_older_message_replace_a_newer_one() {
 
 // ---------------------------------------------------------- network level
 
-/// The leader of README's example: a time-varying reference, so that what
+/// The leader of `docs/scenarios.md`'s example: a time-varying reference, so that what
 /// the leader publishes changes at every stage.
 fn leader() -> (Matrix3<f64>, LeaderState) {
     let c = std::f64::consts::FRAC_1_SQRT_2;

@@ -49,7 +49,8 @@ mod suite;
 mod zping;
 
 use anyhow::{Context as _, bail};
-use clap::{Parser, Subcommand, ValueEnum};
+use attsync::options::WaitArg;
+use clap::{Parser, Subcommand};
 use msgs::config::{Contention, WaitStrategy};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -222,30 +223,6 @@ enum Cmd {
         #[arg(long)]
         stolen_holds: bool,
     },
-}
-
-/// Wait strategies (as `attsync run --wait`).
-#[derive(Debug, Clone, Copy, ValueEnum)]
-enum WaitArg {
-    /// Busy-poll.
-    Spin,
-    /// Poll with sched_yield.
-    Yield,
-    /// Sleep on iceoryx2 events (1 ms slices).
-    Block,
-    /// Yield a while, then block.
-    Adaptive,
-}
-
-impl From<WaitArg> for WaitStrategy {
-    fn from(w: WaitArg) -> Self {
-        match w {
-            WaitArg::Spin => Self::Spin,
-            WaitArg::Yield => Self::Yield,
-            WaitArg::Block => Self::Block,
-            WaitArg::Adaptive => Self::Adaptive,
-        }
-    }
 }
 
 fn id_list(s: Option<String>) -> anyhow::Result<Option<Vec<u32>>> {

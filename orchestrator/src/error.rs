@@ -1,13 +1,7 @@
 //! [`enum@Error`]: every way a command of `attsync` can fail, and the exit code
 //! of each ([`Error::exit_code`]):
 //!
-//! | code | meaning |
-//! |---|---|
-//! | 0 | success |
-//! | 2 | invalid scenario, `--set`, hosts file or option, or a run this machine cannot take (nothing was started) |
-//! | 1 | any other error (a node died, a rule failed, a file could not be written…) |
-//! | 3 | the run diverged: a state left the envelope (`summary.json` `diverged`) |
-//! | 128 + N | interrupted by signal N: 130 SIGINT, 143 SIGTERM, 129 SIGHUP |
+//! The codes are [`crate::exit`]'s table.
 //!
 //! Each error type decides its own code with an `exit_code()`
 //! ([`RunError::exit_code`], [`RunEnd::exit_code`], [`SweepError::exit_code`],
@@ -97,7 +91,9 @@ impl Error {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Scenario(_) | Error::Hosts(_) | Error::Options(_) | Error::Margin(_) => 2,
+            Error::Scenario(_) | Error::Hosts(_) | Error::Options(_) | Error::Margin(_) => {
+                crate::exit::INVALID
+            }
             Error::Run(e) => e.exit_code(),
             Error::RunEnd(e) => e.exit_code(),
             Error::Verify(e) => e.exit_code(),
@@ -105,7 +101,7 @@ impl Error {
             Error::Mc(e) => e.exit_code(),
             Error::Host(e) => e.exit_code(),
             Error::Trust(e) => e.exit_code(),
-            _ => 1,
+            _ => crate::exit::FAILED,
         }
     }
 
@@ -124,9 +120,6 @@ impl Error {
         )
     }
 }
-
-/// The exit code of a run that diverged.
-pub const DIVERGED: u8 = 3;
 
 #[cfg(test)]
 mod tests {

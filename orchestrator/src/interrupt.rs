@@ -45,11 +45,10 @@ pub fn reason(signal: i32) -> String {
     format!("interrupted by {}", signal_name(signal))
 }
 
-/// The exit code of a process stopped by `signal`: 128 + its number (the
-/// shell's convention: SIGINT 130, SIGTERM 143, SIGHUP 129).
+/// The exit code of a process stopped by `signal` ([`crate::exit::interrupted`]).
 #[must_use]
 pub fn exit_code(signal: i32) -> u8 {
-    u8::try_from(128 + signal).unwrap_or(u8::MAX)
+    crate::exit::interrupted(signal)
 }
 
 /// Whether, and by which signal, the work was asked to stop.

@@ -34,21 +34,25 @@
 
 pub mod conform;
 pub mod error;
+pub mod exit;
 #[cfg(feature = "mcap")]
 pub mod export;
 pub mod failure;
 pub mod generate;
 pub mod hosts;
 pub mod interrupt;
+pub mod launch;
 pub mod margin;
 pub mod mc;
 pub mod options;
 pub mod outcome;
+pub mod pool;
 pub mod processes;
+pub mod progress;
 pub mod remote;
 pub mod results;
 pub mod run;
-pub mod scenario;
+pub use ::scenario;
 pub mod sweep;
 pub mod trust;
 pub mod until;

@@ -9,13 +9,14 @@
 //! - `--tolerance`, `--quantum`: finite and > 0;
 //! - `--jobs`, `--threads`: ≥ 1; `--bisect`: 1..=[`MAX_BISECT`].
 //!
-//! `--no-stiffness-check` (`run`, `check`, `sweep`) is a [`StiffnessCheck`]:
+//! `--no-stiffness-check` (`run`, `check`, `sweep`) is a
+//! [`StiffnessCheck`](crate::scenario::StiffnessCheck):
 //! it turns validation's refusal of a `simulation.dt` clearly beyond RK4's
 //! largest stable step (`docs/stiffness.md`) into a warning.
 
-use crate::conform::ConformOptions;
-use crate::generate::TreeParams;
 use attitude::network::Network;
+use clap::ValueEnum;
+use msgs::config::WaitStrategy;
 use thiserror::Error;
 
 /// Longest duration an option may give, s (one day: a wait past it is a
@@ -30,25 +31,27 @@ pub const MAX_REALTIME: f64 = 1e6;
 /// resolution of any bracket).
 pub const MAX_BISECT: u32 = 64;
 
-/// What validation does with a `simulation.dt` clearly beyond the largest
-/// stable RK4 step of the scenario's loops (`docs/stiffness.md`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum StiffnessCheck {
-    /// Refuse the scenario (exit code 2), naming a `dt` that would work.
-    #[default]
-    Refuse,
-    /// Only warn (`--no-stiffness-check`): the run goes on and may diverge.
-    Warn,
+/// `--wait` (`run`, `sweep`, `mc`, `verify`, and the bench): how a node
+/// waits for its inputs.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum WaitArg {
+    /// Busy-poll.
+    Spin,
+    /// Poll with sched_yield.
+    Yield,
+    /// Sleep on iceoryx2 events (1 ms slices).
+    Block,
+    /// Yield a while (≤ 200 polls, 2 ms), then block; block at once on a busy machine.
+    Adaptive,
 }
 
-impl StiffnessCheck {
-    /// The policy of the flag `--no-stiffness-check` (`true` if given).
-    #[must_use]
-    pub fn from_flag(no_stiffness_check: bool) -> Self {
-        if no_stiffness_check {
-            Self::Warn
-        } else {
-            Self::Refuse
+impl From<WaitArg> for WaitStrategy {
+    fn from(w: WaitArg) -> Self {
+        match w {
+            WaitArg::Spin => WaitStrategy::Spin,
+            WaitArg::Yield => WaitStrategy::Yield,
+            WaitArg::Block => WaitStrategy::Block,
+            WaitArg::Adaptive => WaitStrategy::Adaptive,
         }
     }
 }
@@ -148,31 +151,6 @@ pub fn count(option: &'static str, value: u64, min: u64, max: u64) -> Result<(),
 /// The value is 0.
 pub fn threads(value: usize) -> Result<(), OptionError> {
     count("--threads", value as u64, 1, u64::MAX)
-}
-
-/// `gen tree`'s `--agents` (≥ 1), `--leader-links` (1..=agents) and
-/// `--duration` (finite, > 0).
-///
-/// # Errors
-/// The first option out of its range.
-pub fn tree(p: &TreeParams) -> Result<(), OptionError> {
-    count("--agents", u64::from(p.agents), 1, u64::MAX)?;
-    count(
-        "--leader-links",
-        u64::from(p.leader_links),
-        1,
-        u64::from(p.agents),
-    )?;
-    p.duration.map_or(Ok(()), |d| positive("--duration", d))
-}
-
-/// `conform`'s `--stage-timeout` and `--start-timeout` (durations).
-///
-/// # Errors
-/// The first option out of its range.
-pub fn conform(o: &ConformOptions) -> Result<(), OptionError> {
-    seconds("--stage-timeout", o.stage_timeout)?;
-    seconds("--start-timeout", o.start_timeout)
 }
 
 /// The index of node `id` (`option`'s value) in the list leader, agents…

@@ -17,7 +17,7 @@ pub use crate::until::Judging;
 use crate::until::{self, Stopped, Until, UntilSummary};
 use crate::view;
 use attitude::engine::InProcess;
-use indicatif::{ProgressBar, ProgressState, ProgressStyle};
+use indicatif::ProgressBar;
 use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime};
 use thiserror::Error;
@@ -144,8 +144,10 @@ impl RunError {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            RunError::Options(_) | RunError::Capacity(_) | RunError::Hosts(_) => 2,
-            _ => 1,
+            RunError::Options(_) | RunError::Capacity(_) | RunError::Hosts(_) => {
+                crate::exit::INVALID
+            }
+            _ => crate::exit::FAILED,
         }
     }
 }
@@ -319,7 +321,7 @@ fn drive(
     interrupt: &Interrupt,
 ) -> Result<Driven, RunError> {
     let net = &loaded.resolved.network;
-    let bar = progress_bar(opts.progress, net.steps, net.dt);
+    let bar = crate::progress::of_steps(opts.progress, net.steps, net.dt);
     let driven = match opts.engine {
         Engine::InProcess => drive_in_process(loaded, opts, layout, interrupt, &bar)?,
         Engine::Processes => drive_processes(loaded, opts, layout, interrupt, &bar)?,
@@ -654,7 +656,7 @@ impl RunEnd {
     pub fn exit_code(&self) -> u8 {
         match self {
             RunEnd::Interrupted(signal) => crate::interrupt::exit_code(*signal),
-            RunEnd::Diverged(_) => crate::error::DIVERGED,
+            RunEnd::Diverged(_) => crate::exit::DIVERGED,
             RunEnd::Failed(f) => f.exit_code(),
         }
     }
@@ -704,7 +706,7 @@ fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), OptionError> 
 /// process engine's warnings.
 fn check_capacity(loaded: &Loaded, opts: &RunOptions) -> Result<(), CapacityError> {
     let need = Need::of(&loaded.resolved.network, opts.processes.wait);
-    let host = Host::read(&processes::namespace::base_dir());
+    let host = Host::read(&crate::launch::namespace::base_dir());
     match opts.engine {
         Engine::Processes => {
             for warning in capacity::processes(&host, &need)? {
@@ -714,30 +716,6 @@ fn check_capacity(loaded: &Loaded, opts: &RunOptions) -> Result<(), CapacityErro
         }
         Engine::InProcess => capacity::in_process(&host, &need),
     }
-}
-
-fn progress_bar(enabled: bool, steps: u64, dt: f64) -> ProgressBar {
-    if !enabled {
-        return ProgressBar::hidden();
-    }
-    let total = steps as f64 * dt;
-    let style = ProgressStyle::with_template(&format!(
-        "{{bar:40}} t = {{simt}} / {total} s  {{rtf}}× real time  eta {{eta}}"
-    ))
-    .expect("valid template")
-    .with_key(
-        "simt",
-        move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
-            let _ = write!(w, "{:.2}", s.pos() as f64 * dt);
-        },
-    )
-    .with_key(
-        "rtf",
-        move |s: &ProgressState, w: &mut dyn std::fmt::Write| {
-            let _ = write!(w, "{:.1}", s.per_sec() * dt);
-        },
-    );
-    ProgressBar::new(steps).with_style(style)
 }
 
 #[cfg(test)]

@@ -19,12 +19,12 @@
 
 use crate::interrupt::Interrupt;
 use crate::options::{self, OptionError};
-use crate::results::Series;
+pub use crate::results::until::{Stopped, UntilSummary};
+use crate::results::{Series, nan_max};
 use attitude::engine::{InProcess, Snapshot};
 use attitude::metrics::errors;
 use attitude::network::Network;
 use attsync_verdict::{Kind, Thresholds, Verdict};
-use serde::{Deserialize, Serialize};
 
 /// How long a run goes.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -120,13 +120,8 @@ pub fn largest_attitude_error(series: &[Series]) -> (Vec<f64>, Vec<f64>) {
     };
     let x = (0..first.t.len())
         .map(|k| {
-            series.iter().fold(0.0_f64, |m, s| {
-                let e = s.att.get(k).copied().unwrap_or(f64::NAN);
-                if m.is_nan() || e.is_nan() {
-                    f64::NAN
-                } else {
-                    m.max(e)
-                }
+            (series.iter()).fold(0.0_f64, |m, s| {
+                nan_max(m, s.att.get(k).copied().unwrap_or(f64::NAN))
             })
         })
         .collect();
@@ -153,16 +148,10 @@ pub fn settled_horizon(
         let diverged = engine.run_until(
             |_, _, _| (),
             |snap: &Snapshot<'_>, _: &[()]| {
-                let largest = snap.agents.iter().fold(0.0_f64, |m, a| {
-                    let e = errors(a, snap.leader, false).att;
-                    if m.is_nan() || e.is_nan() {
-                        f64::NAN
-                    } else {
-                        m.max(e)
-                    }
+                let largest = (snap.agents.iter()).fold(0.0_f64, |m, a| {
+                    nan_max(m, errors(a, snap.leader, false).att)
                 });
-                let at = crate::results::fmt_time(snap.step, net.dt);
-                t.push(at.parse().expect("fmt_time prints a number"));
+                t.push(crate::results::sample_time(snap.step, net.dt));
                 x.push(largest);
                 !interrupt.is_set()
             },
@@ -178,36 +167,6 @@ pub fn settled_horizon(
         }
         engine.extend_to(next_horizon(engine.horizon(), max, net.sample_every));
     }
-}
-
-/// Why an extended run stopped (`summary.json` `until.stopped`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Stopped {
-    /// The verdict became final.
-    VerdictFinal,
-    /// The horizon reached `--max-duration` first.
-    MaxDuration,
-    /// The run ended otherwise (diverged, failed or interrupted).
-    RunEnded,
-}
-
-/// `summary.json` `until`: how long an `--until settled` run went and why
-/// it stopped.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct UntilSummary {
-    /// `settled`.
-    pub rule: String,
-    /// The scenario's `simulation.duration`, s.
-    pub scenario_duration: f64,
-    /// `--max-duration`, s.
-    pub max_duration: f64,
-    /// The horizon it ended with, s (the run's `duration`).
-    pub duration: f64,
-    /// Chunks run (1: the scenario's horizon sufficed).
-    pub chunks: u32,
-    /// Why it stopped.
-    pub stopped: Stopped,
 }
 
 #[cfg(test)]

@@ -150,8 +150,8 @@ fn scheme_2_runs_the_printed_gamma_and_still_converges() {
     assert!(largest > 1e-3, "the printed Γ changed nothing: {largest:e}");
 }
 
-/// The paper's scheme-1 experiment (Section `simulation`, NOTES.md "The
-/// paper's experiment") integrated from scratch: quaternions `[w, x, y, z]`,
+/// The paper's scheme-1 experiment (Section `simulation`, docs/paper.md "The
+/// 7-agent experiment") integrated from scratch: quaternions `[w, x, y, z]`,
 /// classical RK4 on the whole network at once (continuous coupling),
 /// renormalised after every step.
 mod reference {

@@ -658,7 +658,7 @@ fn sweep_failures_name_the_field_and_leave_nothing() {
     assert!(entries(cwd).is_empty(), "{:?}", entries(cwd));
 }
 
-/// README, "Exit codes": 2 for an invalid scenario or `--set`. A swept
+/// README.md, "Exit codes": 2 for an invalid scenario or `--set`. A swept
 /// `--param` value is applied exactly like a `--set` (and reported with the
 /// same `FILE: FIELD: REASON`), so an invalid one must exit 2 as an invalid
 /// `--set` of the same sweep does.

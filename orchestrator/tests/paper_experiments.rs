@@ -13,7 +13,7 @@
 //! at k_ω̄/J ≈ 130 s⁻¹, so RK4's error in the first tens of milliseconds is
 //! ~1e-6 at 1 ms; it shrinks 16× per halving, which is also checked). Agent 5
 //! of scheme 1 starts on the stable manifold of an unstable equilibrium and
-//! leaves it at a time set by round-off (NOTES.md), so its curve is excluded
+//! leaves it at a time set by round-off (docs/paper.md), so its curve is excluded
 //! from the comparison after it escapes.
 
 mod common;

@@ -11,7 +11,7 @@
 
 mod common;
 
-use attsync::options::StiffnessCheck;
+use attsync::scenario::StiffnessCheck;
 use attsync::scenario::{Loaded, ScenarioError, load, load_with};
 use common::{attsync, paper, run_args, stays_finite};
 use std::path::Path;

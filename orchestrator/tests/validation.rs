@@ -1,7 +1,7 @@
 //! Every way a scenario can break the paper's assumptions is caught before
 //! anything runs, and reported with the file, the field and the reason.
 //!
-//! The paper (shared/paper/NOTES.md) assumes:
+//! The paper (docs/paper.md) assumes:
 //! - Assumption 1: the followers' graph is undirected and acyclic (a forest),
 //!   and every agent is reachable from the leader through some leader link;
 //! - every gain matrix `A` (`A_i0`, `A_ij`, `Āᵢ`) is symmetric positive
@@ -712,7 +712,7 @@ fn duration_must_be_a_positive_multiple_of_dt() {
         Path::new(FILE),
         BASE,
         &sets,
-        attsync::options::StiffnessCheck::Warn,
+        attsync::scenario::StiffnessCheck::Warn,
     )
     .unwrap_or_else(|e| panic!("expected a valid scenario, got:\n{e}"));
     assert_eq!(l.resolved.network.steps, 3);

@@ -12,7 +12,7 @@ use std::process::{Command, Stdio};
 pub(crate) const SHM_DIR: &str = "/dev/shm";
 
 /// Parent of every run's iceoryx2 root directory, as the orchestrator
-/// chooses it (`attsync::processes::namespace::base_dir`): `$TMPDIR/attsync-iox2`
+/// chooses it (`attsync::launch::namespace::base_dir`): `$TMPDIR/attsync-iox2`
 /// where `TMPDIR` is set (as the child sees it), else `/dev/shm/attsync-iox2`
 /// if that exists, else `/tmp/attsync-iox2`. (A `TMPDIR` too long for socket
 /// paths is the business of the test that sets it.)

@@ -3,7 +3,7 @@
 //! in its process group.
 
 use super::{ConformError, ConformOptions};
-use crate::processes::supervise::{Supervisor, group_members, kill_group, tail};
+use crate::launch::supervise::{Supervisor, group_members, kill_group, tail};
 use crate::processes::{ProcessOptions, node_configs};
 use attitude::network::Network;
 use msgs::config::NodeConfig;

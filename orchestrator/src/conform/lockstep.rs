@@ -8,7 +8,7 @@ use super::harness::{Drive, Halt};
 use super::law::ExchangeRecord;
 use super::neighbourhood::Neighbourhood;
 use super::rules::RuleId;
-use crate::processes::supervise::describe;
+use crate::launch::supervise::describe;
 use attitude::network::Exchanged;
 use attitude::schedule::{Schedule, Slot};
 use msgs::{PROTOCOL_VERSION, StateMsg};

@@ -52,6 +52,17 @@ pub struct ConformOptions {
     pub law: LawMode,
 }
 
+impl ConformOptions {
+    /// `conform`'s `--stage-timeout` and `--start-timeout` (durations).
+    ///
+    /// # Errors
+    /// The first option out of its range.
+    pub fn check(&self) -> Result<(), crate::options::OptionError> {
+        crate::options::seconds("--stage-timeout", self.stage_timeout)?;
+        crate::options::seconds("--start-timeout", self.start_timeout)
+    }
+}
+
 /// How rule `law` judges a candidate whose published states depart from
 /// the built-in law of its scheme.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -4,8 +4,8 @@
 use super::candidate::{Candidate, EXIT_TIMEOUT, candidate_config, success};
 use super::rules::{Report, RuleId};
 use super::{ConformError, ConformOptions};
-use crate::processes::namespace::{self, Namespace};
-use crate::processes::supervise::describe;
+use crate::launch::namespace::{self, Namespace};
+use crate::launch::supervise::describe;
 use attitude::network::Network;
 use msgs::PROTOCOL_VERSION;
 

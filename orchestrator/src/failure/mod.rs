@@ -102,9 +102,9 @@ impl Failure {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self.root() {
-            Failure::Diverged(_) => crate::error::DIVERGED,
+            Failure::Diverged(_) => crate::exit::DIVERGED,
             Failure::Interrupted(Some(signal)) => crate::interrupt::exit_code(*signal),
-            _ => 1,
+            _ => crate::exit::FAILED,
         }
     }
 }

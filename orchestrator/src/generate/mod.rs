@@ -44,6 +44,21 @@ pub struct TreeParams {
 }
 
 impl TreeParams {
+    /// `gen tree`'s `--agents` (≥ 1), `--leader-links` (1..=agents) and
+    /// `--duration` (finite, > 0).
+    ///
+    /// # Errors
+    /// The first option out of its range.
+    pub fn check(&self) -> Result<(), crate::options::OptionError> {
+        use crate::options::{count, positive};
+        count("--agents", u64::from(self.agents), 1, u64::MAX)?;
+        let links = u64::from(self.leader_links);
+        count("--leader-links", links, 1, u64::from(self.agents))?;
+        self.duration.map_or(Ok(()), |d| positive("--duration", d))
+    }
+}
+
+impl TreeParams {
     /// The command that generates this tree, every parameter given (the
     /// first line of the file `attsync gen tree` writes).
     #[must_use]

@@ -5,7 +5,7 @@
 //! does not depend on the gains, and the stiffness estimate depends on `dt`
 //! and the duration not at all.
 
-use crate::options::StiffnessCheck;
+use crate::scenario::StiffnessCheck;
 use crate::scenario::resolve::{self, MAX_STEPS, Resolved, stable_dt};
 use crate::scenario::schema::Scenario;
 use attitude::network::Scheme;

@@ -37,58 +37,56 @@ pub struct Draws {
     pub leader: NodeDraws,
 }
 
-impl Dispersion {
-    /// The draws of one trial, from its stream `rng`.
-    pub fn draw(&self, rng: &mut impl Rng) -> Draws {
-        let (w, s) = (self.omega_max, self.sigma_max);
-        let mut node = || NodeDraws {
-            attitude: haar_quaternion(rng),
-            omega: bounded_vector(rng, w),
-            attitude_hat: haar_quaternion(rng),
-            omega_hat: bounded_vector(rng, w),
-            sigma_hat: bounded_vector(rng, s),
-        };
-        let agents = (0..self.agents).map(|_| node()).collect();
-        let leader = NodeDraws {
-            attitude_hat: [1.0, 0.0, 0.0, 0.0],
-            omega_hat: [0.0; 3],
-            ..node()
-        };
-        Draws { agents, leader }
-    }
+/// The draws of one trial of `dispersion`, from its stream `rng`.
+pub fn draw(dispersion: &Dispersion, rng: &mut impl Rng) -> Draws {
+    let (w, s) = (dispersion.omega_max, dispersion.sigma_max);
+    let mut node = || NodeDraws {
+        attitude: haar_quaternion(rng),
+        omega: bounded_vector(rng, w),
+        attitude_hat: haar_quaternion(rng),
+        omega_hat: bounded_vector(rng, w),
+        sigma_hat: bounded_vector(rng, s),
+    };
+    let agents = (0..dispersion.agents).map(|_| node()).collect();
+    let leader = NodeDraws {
+        attitude_hat: [1.0, 0.0, 0.0, 0.0],
+        omega_hat: [0.0; 3],
+        ..node()
+    };
+    Draws { agents, leader }
+}
 
-    /// The `--set` overrides that put the dispersed draws into the
-    /// scenario (numbers in Rust's shortest round-trip form: exact).
-    #[must_use]
-    pub fn overrides(&self, d: &Draws) -> Vec<String> {
-        let mut out = Vec::new();
-        for (k, a) in d.agents.iter().enumerate() {
-            let f = format!("agent[{k}]");
-            let mut set = |q: Quantity, key: &str, value: String| {
-                if self.has(q) {
-                    out.push(format!("{f}.{key}={value}"));
-                }
-            };
-            set(Quantity::Attitude, "attitude", rotation(&a.attitude));
-            set(Quantity::Omega, "omega", vector(&a.omega));
-            set(
-                Quantity::AttitudeHat,
-                "observer.attitude",
-                rotation(&a.attitude_hat),
-            );
-            set(Quantity::OmegaHat, "observer.omega", vector(&a.omega_hat));
-            set(Quantity::SigmaHat, "observer.sigma", vector(&a.sigma_hat));
-        }
-        let l = &d.leader;
-        if self.leader != LeaderDispersion::None {
-            out.push(format!("leader.attitude={}", rotation(&l.attitude)));
-        }
-        if self.leader == LeaderDispersion::State {
-            out.push(format!("leader.omega={}", vector(&l.omega)));
-            out.push(format!("leader.sigma={}", vector(&l.sigma_hat)));
-        }
-        out
+/// The `--set` overrides that put `dispersion`'s dispersed draws `d` into
+/// the scenario (numbers in Rust's shortest round-trip form: exact).
+#[must_use]
+pub fn overrides(dispersion: &Dispersion, d: &Draws) -> Vec<String> {
+    let mut out = Vec::new();
+    for (k, a) in d.agents.iter().enumerate() {
+        let f = format!("agent[{k}]");
+        let mut set = |q: Quantity, key: &str, value: String| {
+            if dispersion.has(q) {
+                out.push(format!("{f}.{key}={value}"));
+            }
+        };
+        set(Quantity::Attitude, "attitude", rotation(&a.attitude));
+        set(Quantity::Omega, "omega", vector(&a.omega));
+        set(
+            Quantity::AttitudeHat,
+            "observer.attitude",
+            rotation(&a.attitude_hat),
+        );
+        set(Quantity::OmegaHat, "observer.omega", vector(&a.omega_hat));
+        set(Quantity::SigmaHat, "observer.sigma", vector(&a.sigma_hat));
     }
+    let l = &d.leader;
+    if dispersion.leader != LeaderDispersion::None {
+        out.push(format!("leader.attitude={}", rotation(&l.attitude)));
+    }
+    if dispersion.leader == LeaderDispersion::State {
+        out.push(format!("leader.omega={}", vector(&l.omega)));
+        out.push(format!("leader.sigma={}", vector(&l.sigma_hat)));
+    }
+    out
 }
 
 /// `[x,y,z]` (TOML; `{:?}` keeps `-0.0` and every digit).

@@ -7,22 +7,20 @@
 use super::dispersion::Dispersion;
 use super::error::{McError, io_at};
 use super::options::McOptions;
-use super::outcome::{End, Trace, TrialResult, classify, nan_max};
+use super::outcome::{End, Trace, TrialResult, classify};
 use super::plot;
 use super::report::{self, McSummary};
 use super::trial::{Base, Prepared, Ran, run_in_process, run_processes};
 use crate::interrupt::Interrupt;
 use crate::options::OptionError;
+use crate::pool::Flow;
 use crate::processes::capacity::{self, Host, Need};
-use crate::processes::{self};
 use crate::results::layout;
+use crate::results::nan_max;
 use crate::results::staging::Staging;
 use crate::run::{Engine, RunOptions};
 use crate::scenario::{ScenarioError, input};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::path::Path;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 /// A finished Monte Carlo.
@@ -79,7 +77,7 @@ pub fn load_base(o: &McOptions) -> Result<Base, McError> {
 /// `jobs` of them); logs the process engine's warnings.
 fn check_capacity(base: &Base, o: &McOptions) -> Result<(), McError> {
     let need = Need::of(&base.loaded.resolved.network, o.processes.wait);
-    let host = Host::read(&processes::namespace::base_dir());
+    let host = Host::read(&crate::launch::namespace::base_dir());
     match o.engine {
         Engine::Processes => {
             for warning in capacity::processes(&host, &need)? {
@@ -185,61 +183,30 @@ fn one(
 }
 
 /// Trials `0..o.trials` on `o.jobs` workers; the results by index (those
-/// an interrupt prevented are missing).
+/// an interrupt prevented are missing). The first failed trial (by index)
+/// stops the pool and is the error.
 fn run_pool(
     base: &Base,
     o: &McOptions,
     dir: &Path,
     interrupt: &Interrupt,
 ) -> Result<Vec<TrialResult>, McError> {
-    let next = AtomicU64::new(0);
-    let abort = AtomicBool::new(false);
-    let slots: Mutex<Vec<Option<TrialResult>>> = Mutex::new(vec![None; o.trials as usize]);
-    let error: Mutex<Option<McError>> = Mutex::new(None);
-    let bar = progress_bar(o.progress, o.trials);
-    let workers = (o.jobs as u64).min(o.trials).max(1);
-    std::thread::scope(|s| {
-        for _ in 0..workers {
-            s.spawn(|| {
-                loop {
-                    let k = next.fetch_add(1, Ordering::Relaxed);
-                    if k >= o.trials || interrupt.is_set() || abort.load(Ordering::Relaxed) {
-                        return;
-                    }
-                    match one(base, o, k, dir, interrupt) {
-                        Ok(Ran::Done(r)) => slots.lock().expect("lock")[k as usize] = Some(r),
-                        Ok(Ran::Interrupted) => return,
-                        Err(e) => {
-                            abort.store(true, Ordering::Relaxed);
-                            error.lock().expect("lock").get_or_insert(e);
-                            return;
-                        }
-                    }
-                    bar.inc(1);
-                }
-            });
-        }
-    });
+    let bar = crate::progress::of_jobs(o.progress, o.trials, "trials");
+    let ran = crate::pool::run(
+        o.trials as usize,
+        o.jobs,
+        || interrupt.is_set(),
+        |k| match one(base, o, k as u64, dir, interrupt) {
+            Ok(Ran::Done(r)) => {
+                bar.inc(1);
+                Flow::Next(Ok(r))
+            }
+            Ok(Ran::Interrupted) => Flow::Stop(None),
+            Err(e) => Flow::Stop(Some(Err(e))),
+        },
+    );
     bar.finish_and_clear();
-    if let Some(e) = error.into_inner().expect("lock") {
-        return Err(e);
-    }
-    let results: Vec<TrialResult> = slots
-        .into_inner()
-        .expect("lock")
-        .into_iter()
-        .flatten()
-        .collect();
-    Ok(results)
-}
-
-fn progress_bar(enabled: bool, trials: u64) -> ProgressBar {
-    if !enabled {
-        return ProgressBar::hidden();
-    }
-    let style = ProgressStyle::with_template("{bar:40} {pos}/{len} trials  {per_sec}  eta {eta}")
-        .expect("valid template");
-    ProgressBar::new(trials).with_style(style)
+    ran.into_iter().flatten().collect()
 }
 
 /// `trials.csv`, `initial.csv` (draws recomputed from each trial's seed),
@@ -257,7 +224,7 @@ fn write_files(
     let ids: Vec<u32> = (base.loaded.scenario.agents.iter()).map(|a| a.id).collect();
     let mut initial = format!("{}\n", report::INITIAL_HEADER);
     for r in results {
-        let draws = base.dispersion.draw(&mut super::trial_rng(r.seed));
+        let draws = super::draws::draw(&base.dispersion, &mut super::trial_rng(r.seed));
         report::initial_rows(&mut initial, r.trial, &ids, &base.dispersion, &draws);
     }
     write(files.initial(), &initial)?;
@@ -363,7 +330,7 @@ pub fn run_command(o: &McOptions, p: &Prepared) -> String {
         super::draws::shell_quote(&o.scenario.display().to_string()),
         o.engine.name()
     );
-    if o.stiffness == crate::options::StiffnessCheck::Warn {
+    if o.stiffness == crate::scenario::StiffnessCheck::Warn {
         c += " --no-stiffness-check";
     }
     for s in o.set.iter().chain(&p.overrides) {

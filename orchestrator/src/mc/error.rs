@@ -64,10 +64,12 @@ impl McError {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            McError::Scenario(_) | McError::Options(_) | McError::Capacity(_) => 2,
+            McError::Scenario(_) | McError::Options(_) | McError::Capacity(_) => {
+                crate::exit::INVALID
+            }
             McError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
             McError::Run(e) => e.exit_code(),
-            _ => 1,
+            _ => crate::exit::FAILED,
         }
     }
 }

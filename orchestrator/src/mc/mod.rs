@@ -20,7 +20,7 @@
 //! - [`options`], `error`, `driver`: [`McOptions`], [`McError`], and
 //!   [`monte_carlo`] / [`trial_alone`] (the work queue, the files).
 
-pub mod dispersion;
+pub use crate::scenario::monte_carlo as dispersion;
 pub mod draws;
 mod driver;
 mod error;

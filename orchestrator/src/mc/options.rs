@@ -1,13 +1,14 @@
 //! [`McOptions`]: what `attsync mc` runs and how.
 
-use crate::options::{self, OptionError, StiffnessCheck};
+use crate::options::{self, OptionError};
 use crate::processes::ProcessOptions;
 use crate::run::Engine;
+use crate::scenario::StiffnessCheck;
 use std::path::PathBuf;
 
 /// Default `--tolerance`: the largest `|Rᵢ R₀ᵀ|_I` over agents below it and
-/// staying there (chosen by measurement on the paper's scenarios, README
-/// "Monte Carlo").
+/// staying there (chosen by measurement on the paper's scenarios,
+/// `docs/monte-carlo.md`).
 pub const DEFAULT_TOLERANCE: f64 = 1e-4;
 
 /// A Monte Carlo's options.

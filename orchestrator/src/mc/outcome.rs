@@ -97,14 +97,7 @@ pub struct Trace {
     has_observer: bool,
 }
 
-/// `max` that keeps a NaN (`f64::max` drops it).
-pub(super) fn nan_max(a: f64, b: f64) -> f64 {
-    if a.is_nan() || b.is_nan() {
-        f64::NAN
-    } else {
-        a.max(b)
-    }
-}
+use crate::results::nan_max;
 
 impl Trace {
     /// An empty trace for a network with step `dt`.
@@ -119,18 +112,13 @@ impl Trace {
 
     /// Records the errors of `snap` (the same numbers `errors.csv` has).
     pub fn record(&mut self, snap: &Snapshot<'_>) {
-        let t_str = crate::results::fmt_time(snap.step, self.dt);
         let (mut att, mut angvel) = (0.0_f64, 0.0_f64);
         for x in snap.agents {
             let e = errors(x, snap.leader, self.has_observer);
             att = nan_max(att, e.att);
             angvel = nan_max(angvel, e.angvel);
         }
-        self.push(
-            t_str.parse().expect("fmt_time prints a number"),
-            att,
-            angvel,
-        );
+        self.push(crate::results::sample_time(snap.step, self.dt), att, angvel);
     }
 
     /// Appends a sample at time `t` whose largest errors over agents are

@@ -7,9 +7,9 @@ use super::draws::Draws;
 use super::outcome::{End, Trace, TrialResult, classify};
 use super::seed::{trial_rng, trial_seed};
 use crate::interrupt::Interrupt;
-use crate::options::StiffnessCheck;
 use crate::processes::{self, ProcessError, ProcessOptions};
 use crate::run::Judging;
+use crate::scenario::StiffnessCheck;
 use crate::scenario::{self, Loaded, ScenarioError};
 use crate::until;
 use attitude::engine::{InProcess, Snapshot};
@@ -58,8 +58,8 @@ impl Base {
     /// scenario was already).
     pub fn prepare(&self, k: u64) -> Result<Prepared, ScenarioError> {
         let seed = trial_seed(self.seed, k);
-        let draws = self.dispersion.draw(&mut trial_rng(seed));
-        let overrides = self.dispersion.overrides(&draws);
+        let draws = super::draws::draw(&self.dispersion, &mut trial_rng(seed));
+        let overrides = super::draws::overrides(&self.dispersion, &draws);
         let all: Vec<String> = self.set.iter().chain(&overrides).cloned().collect();
         let loaded = scenario::load_str_with(&self.file, &self.text, &all, self.check)?;
         Ok(Prepared {

@@ -4,8 +4,8 @@
 
 use super::Session;
 use super::collect::Collector;
-use super::supervise::{describe, tail};
 use crate::failure::Failure;
+use crate::launch::supervise::{describe, tail};
 use std::time::{Duration, Instant};
 
 impl Session<'_> {

@@ -17,10 +17,9 @@
 //! - `collect`: per-node bookkeeping (one `NodeSlot` per node), telemetry into snapshots.
 //! - `blame`: which node made the run fail, and why.
 //! - `shutdown`: `Stop` and the exits, or killing every node.
-//! - [`supervise`]: the node processes (tokio): spawn, exits, kill.
+//! - [`crate::launch`]: a node's process, its log and the run's namespace.
 //! - [`placement`]: spread the nodes over the cores, or pack them onto one
 //!   while the machine is busy (`load`: the CPU load it decides on).
-//! - [`namespace`]: a run's iceoryx2 namespace on this machine.
 //! - [`capacity`]: how many nodes this machine can run, checked before anything starts.
 
 mod blame;
@@ -28,8 +27,6 @@ pub mod capacity;
 mod collect;
 mod configs;
 mod load;
-pub mod namespace;
-pub mod node_log;
 pub mod partition;
 pub mod placement;
 pub mod ports;
@@ -37,11 +34,11 @@ pub mod reaper;
 mod shutdown;
 pub mod site;
 mod startup;
-pub mod supervise;
 
 pub use configs::node_configs;
 pub use ports::Ports;
 
+use crate::launch::supervise::Supervisor;
 use crate::outcome::Outcome;
 use crate::scenario::plugin::Plugin;
 use attitude::engine::Snapshot;
@@ -52,7 +49,6 @@ use msgs::iox::IoxError;
 use msgs::open::OpenError;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
-use supervise::Supervisor;
 use thiserror::Error;
 
 /// Options of the process engine.
@@ -94,7 +90,7 @@ impl Default for ProcessOptions {
 pub enum ProcessError {
     /// A node binary is missing.
     #[error(transparent)]
-    MissingBinary(#[from] supervise::MissingBinaries),
+    MissingBinary(#[from] crate::launch::supervise::MissingBinaries),
     /// An iceoryx2 call failed.
     #[error(transparent)]
     Iceoryx(#[from] IoxError),

@@ -5,7 +5,7 @@
 //! `conform` open theirs with [`Ports::open`].
 
 use super::ProcessError;
-use super::namespace::Namespace;
+use crate::launch::namespace::Namespace;
 use iceoryx2::node::Node;
 use iceoryx2::port::listener::Listener;
 use iceoryx2::port::publisher::Publisher;

@@ -3,8 +3,8 @@
 //! node killed.
 
 use super::Session;
-use super::supervise::describe;
 use crate::failure::Failure;
+use crate::launch::supervise::describe;
 use msgs::{ControlCommand, ControlMsg};
 use std::time::Duration;
 

@@ -4,11 +4,11 @@
 
 use super::collect::{Collector, NodeSlot};
 use super::configs::{node_configs, node_id, node_label, node_name, plugin_of};
-use super::namespace::{self, Namespace};
 use super::site::{Setup, SetupNode};
-use super::supervise::{Launch, Supervisor, find_binaries};
 use super::{ProcessError, ProcessOptions, Session, io_at};
 use crate::failure::Failure;
+use crate::launch::namespace::{self, Namespace};
+use crate::launch::supervise::{Launch, Supervisor, find_binaries};
 use attitude::network::Network;
 use iceoryx2::service::port_factory::PortFactory;
 use msgs::{ControlCommand, ControlMsg, Limits};

@@ -18,7 +18,7 @@ use super::wire::{
 };
 use super::zconfig;
 pub use crate::failure::RemoteError;
-use crate::processes::node_log::cut_note;
+use crate::launch::node_log::cut_note;
 use crate::processes::site::{Setup, SiteExit};
 use msgs::ControlMsg;
 use msgs::bytes::Bytes;

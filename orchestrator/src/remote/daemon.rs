@@ -55,8 +55,8 @@ impl HostError {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            Self::Invalid(_) | Self::Config(ConfigError::Endpoint { .. }) => 2,
-            _ => 1,
+            Self::Invalid(_) | Self::Config(ConfigError::Endpoint { .. }) => crate::exit::INVALID,
+            _ => crate::exit::FAILED,
         }
     }
 }

@@ -1,7 +1,7 @@
 //! Why a host refuses a run request ([`RequestError`]) or cannot start the
 //! nodes of one it admitted ([`StartError`]); the orchestrator gets the text.
 
-use crate::processes::supervise::MissingBinaries;
+use crate::launch::supervise::MissingBinaries;
 use crate::trust::allow::AdmitError;
 use msgs::iox::IoxError;
 use msgs::open::OpenError;

@@ -30,6 +30,7 @@ pub mod plot;
 pub mod staging;
 pub mod states;
 pub mod summary;
+pub mod until;
 
 use attitude::engine::Snapshot;
 use attitude::metrics::{Errors, errors};
@@ -131,6 +132,29 @@ pub fn fmt_time(step: u64, dt: f64) -> String {
     }
 }
 
+/// A printed sample time ([`fmt_time`]) read back.
+fn read_time(printed: &str) -> f64 {
+    printed.parse().expect("fmt_time prints a number")
+}
+
+/// The sample time `step · dt` as `errors.csv` prints it, read back: the
+/// series, plots, frames and verdicts hold exactly the printed values.
+#[must_use]
+pub fn sample_time(step: u64, dt: f64) -> f64 {
+    read_time(&fmt_time(step, dt))
+}
+
+/// The larger of `a` and `b`, NaN if either is: the largest error over
+/// agents is NaN once any agent's is.
+#[must_use]
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
+}
+
 impl Recorder {
     /// Starts `errors.csv` and `states.bin` in `dir` for `net`.
     pub fn new(dir: &Path, scenario: &str, net: &Network) -> Result<Self, WriteError> {
@@ -190,7 +214,7 @@ impl Recorder {
     /// The `errors.csv` rows and series samples of step `step`.
     fn record_errors(&mut self, step: u64, rows: &[Row]) -> io::Result<()> {
         let t_str = fmt_time(step, self.dt);
-        let t: f64 = t_str.parse().expect("fmt_time prints a number");
+        let t = read_time(&t_str);
         for (row, s) in rows.iter().zip(&mut self.series) {
             let e = &row.errors;
             s.t.push(t);

@@ -173,7 +173,7 @@ pub struct Summary {
     pub verdict: Option<attsync_verdict::Verdict>,
     /// `--until settled`: how far the horizon was extended and why it stopped.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub until: Option<crate::until::UntilSummary>,
+    pub until: Option<super::until::UntilSummary>,
     /// A run across hosts (`--hosts`): the hosts and how the links were secured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hosts: Option<HostsSummary>,
@@ -379,13 +379,13 @@ impl Summary {
                 u.duration,
                 u.chunks,
                 match u.stopped {
-                    crate::until::Stopped::VerdictFinal =>
+                    super::until::Stopped::VerdictFinal =>
                         "stopped when the verdict was final".to_string(),
-                    crate::until::Stopped::MaxDuration => format!(
+                    super::until::Stopped::MaxDuration => format!(
                         "stopped at --max-duration {} s before the verdict was final",
                         u.max_duration
                     ),
-                    crate::until::Stopped::RunEnded => "stopped when the run ended".to_string(),
+                    super::until::Stopped::RunEnded => "stopped when the run ended".to_string(),
                 }
             );
         }

@@ -26,15 +26,16 @@ pub use files::{CSV_HEADER, table};
 pub use margin::{LinearMargin, MarginResult};
 
 use crate::interrupt::Interrupt;
-use crate::options::{self, OptionError, StiffnessCheck};
+use crate::options::{self, OptionError};
+use crate::pool::Flow;
 use crate::results::layout::SweepLayout;
 use crate::results::staging::Staging;
 use crate::results::summary::Settle;
 use crate::run::{Engine, RunError, RunOptions, run};
+use crate::scenario::StiffnessCheck;
 use crate::scenario::{self, Loaded, ScenarioError};
 use attsync_verdict::{Kind, Verdict};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use thiserror::Error;
 
 /// What to sweep and how.
@@ -136,10 +137,10 @@ impl SweepError {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            SweepError::Scenario(_) | SweepError::Options(_) => 2,
+            SweepError::Scenario(_) | SweepError::Options(_) => crate::exit::INVALID,
             SweepError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
             SweepError::Run { source, .. } => source.exit_code(),
-            _ => 1,
+            _ => crate::exit::FAILED,
         }
     }
 }
@@ -352,34 +353,16 @@ fn run_many(
     values: &[String],
     interrupt: &Interrupt,
 ) -> Result<Vec<SweepRow>, SweepError> {
-    let next = Mutex::new(0usize);
-    let out: Mutex<Vec<Option<Result<SweepRow, SweepError>>>> =
-        Mutex::new(values.iter().map(|_| None).collect());
-    std::thread::scope(|s| {
-        for _ in 0..o.jobs.max(1).min(values.len()) {
-            s.spawn(|| {
-                loop {
-                    let k = {
-                        let mut n = next.lock().expect("lock");
-                        let k = *n;
-                        *n += 1;
-                        k
-                    };
-                    if k >= values.len() || interrupt.is_set() {
-                        return;
-                    }
-                    let r = run_one(o, dir, first + k, &values[k], interrupt);
-                    out.lock().expect("lock")[k] = Some(r);
-                }
-            });
-        }
-    });
+    let out = crate::pool::run(
+        values.len(),
+        o.jobs,
+        || interrupt.is_set(),
+        |k| Flow::Next(run_one(o, dir, first + k, &values[k], interrupt)),
+    );
     if interrupt.is_set() {
         return Err(interrupted(interrupt));
     }
-    out.into_inner()
-        .expect("lock")
-        .into_iter()
+    out.into_iter()
         .map(|r| r.unwrap_or_else(|| Err(interrupted(interrupt))))
         .collect()
 }

@@ -116,8 +116,8 @@ impl TrustError {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            Self::Certs(_) => 1,
-            _ => 2,
+            Self::Certs(_) => crate::exit::FAILED,
+            _ => crate::exit::INVALID,
         }
     }
 }

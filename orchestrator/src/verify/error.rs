@@ -109,9 +109,9 @@ impl VerifyError {
             | Self::Realtime { .. }
             | Self::Incomplete { .. }
             | Self::Scenario(_)
-            | Self::Run(RunError::Options(_) | RunError::Capacity(_)) => 2,
+            | Self::Run(RunError::Options(_) | RunError::Capacity(_)) => crate::exit::INVALID,
             Self::Interrupted(signal) => crate::interrupt::exit_code(*signal),
-            _ => 1,
+            _ => crate::exit::FAILED,
         }
     }
 }

@@ -37,7 +37,6 @@ pub use error::VerifyError;
 pub use report::Report;
 
 use crate::interrupt::Interrupt;
-use crate::options::StiffnessCheck;
 use crate::processes::ProcessOptions;
 use crate::processes::placement::Placement;
 use crate::results::digest::sha256_hex;
@@ -45,6 +44,7 @@ use crate::results::fmt_time;
 use crate::results::layout::RunLayout;
 use crate::results::manifest::Manifest;
 use crate::run::{self, Engine, RunOptions};
+use crate::scenario::StiffnessCheck;
 use crate::scenario::{self, Loaded};
 use msgs::config::WaitStrategy;
 use std::path::Path;

@@ -136,7 +136,7 @@ impl Collector {
     /// Appends the frame of one snapshot.
     fn take(&mut self, step: u64, leader: &LeaderState, agents: &[AgentState]) {
         let f = &mut self.frames;
-        let t: f64 = (crate::results::fmt_time(step, self.dt).parse()).expect("a number");
+        let t = crate::results::sample_time(step, self.dt);
         f.t.push(t);
         f.q[0].extend(quaternion(&leader.r0));
         for (k, x) in agents.iter().enumerate() {

@@ -164,7 +164,7 @@ fn network_of(file: &Path) -> Result<Network, ViewError> {
     let text = std::fs::read_to_string(file).map_err(|e| err(e.to_string()))?;
     let scenario: crate::scenario::Scenario =
         toml::from_str(&text).map_err(|e| err(e.to_string()))?;
-    let check = crate::options::StiffnessCheck::Warn;
+    let check = crate::scenario::StiffnessCheck::Warn;
     match crate::scenario::resolve::resolve_with(&scenario, check) {
         Ok(r) => Ok(r.network),
         Err(issues) => Err(err(issues

@@ -4,8 +4,8 @@
 use super::ScenarioArgs;
 use attsync::Error;
 use attsync::hosts::{self, Placement};
-use attsync::options::StiffnessCheck;
 use attsync::processes::{self, ProcessOptions};
+use attsync::scenario::StiffnessCheck;
 use std::path::PathBuf;
 
 /// `attsync check SCENARIO [--set K=V]… [--hosts FILE] [--node-config ID] [--no-stiffness-check]`.
@@ -50,7 +50,7 @@ pub fn exec(a: Check) -> Result<(), Error> {
     };
     let net = &loaded.resolved.network;
     let index = attsync::options::node_index(net, id, "--node-config", true, &loaded.file)?;
-    let root = processes::namespace::base_dir().join("RUN");
+    let root = attsync::launch::namespace::base_dir().join("RUN");
     let cfg =
         processes::node_configs(net, "RUN", &root, &ProcessOptions::default()).swap_remove(index);
     println!(

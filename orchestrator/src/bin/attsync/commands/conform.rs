@@ -77,7 +77,7 @@ pub fn exec(a: Conform) -> Result<(), Error> {
             LawArg::Own => LawMode::Own,
         },
     };
-    attsync::options::conform(&opts)?;
+    opts.check()?;
     let loaded = conform::neighbourhood(&opts)?;
     let net = &loaded.resolved.network;
     attsync::options::node_index(net, opts.agent, "--agent", false, &loaded.file)?;

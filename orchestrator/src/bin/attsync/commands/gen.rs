@@ -77,7 +77,7 @@ pub fn exec(a: GenCmd) -> Result<(), Error> {
         scheme: scheme.into(),
         duration,
     };
-    attsync::options::tree(&p)?;
+    p.check()?;
     // What `tree` refuses is the arguments (a duration `check` would
     // refuse, a tree too large for any horizon): invalid input, exit 2.
     let g = tree(&p).map_err(|e| Error::Options(OptionError::Conflict(e.to_string())))?;

@@ -2,7 +2,7 @@
 
 use super::ScenarioArgs;
 use attsync::Error;
-use attsync::options::StiffnessCheck;
+use attsync::scenario::StiffnessCheck;
 use std::path::PathBuf;
 
 /// `attsync margin SCENARIO [--set K=V]… [--json FILE]`.

@@ -16,12 +16,12 @@ mod view;
 use attsync::Error;
 use attsync::hosts::Hosts;
 use attsync::interrupt::Interrupt;
+pub use attsync::options::WaitArg;
 use attsync::processes::ProcessOptions;
 use attsync::processes::placement::Placement;
 use attsync::run::Engine;
 use attsync::scenario::{self, Loaded};
 use clap::{Subcommand, ValueEnum};
-use msgs::config::WaitStrategy;
 use std::path::{Path, PathBuf};
 
 /// The subcommands.
@@ -110,7 +110,7 @@ pub struct ScenarioArgs {
 impl ScenarioArgs {
     /// The scenario with its overrides, validated (`check`: what to do with
     /// a step beyond RK4's stable one, `--no-stiffness-check`).
-    pub fn load(&self, check: attsync::options::StiffnessCheck) -> Result<Loaded, Error> {
+    pub fn load(&self, check: attsync::scenario::StiffnessCheck) -> Result<Loaded, Error> {
         Ok(scenario::load_with(
             &self.scenario,
             &self.overrides.set,
@@ -163,8 +163,8 @@ impl UntilArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct HostsArgs {
     /// Spread the nodes over machines as this placement file says
-    /// (HOSTS.toml: [[host]] name, endpoint, agents, leader; README "Across
-    /// machines"); nodes on no host run on this machine. Processes engine.
+    /// (HOSTS.toml: [[host]] name, endpoint, agents, leader; docs/hosts.md);
+    /// nodes on no host run on this machine. Processes engine.
     #[arg(long, value_name = "HOSTS.toml")]
     pub hosts: Option<PathBuf>,
     /// With --hosts: the lab's CA certificate (PEM), instead of the hosts
@@ -234,30 +234,6 @@ impl EngineArgs {
             realtime,
             placement: self.placement,
             ..ProcessOptions::default()
-        }
-    }
-}
-
-/// `--wait`.
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum WaitArg {
-    /// Busy-poll.
-    Spin,
-    /// Poll with sched_yield.
-    Yield,
-    /// Sleep on iceoryx2 events (1 ms slices).
-    Block,
-    /// Yield a while (≤ 200 polls, 2 ms), then block; block at once on a busy machine.
-    Adaptive,
-}
-
-impl From<WaitArg> for WaitStrategy {
-    fn from(w: WaitArg) -> Self {
-        match w {
-            WaitArg::Spin => WaitStrategy::Spin,
-            WaitArg::Yield => WaitStrategy::Yield,
-            WaitArg::Block => WaitStrategy::Block,
-            WaitArg::Adaptive => WaitStrategy::Adaptive,
         }
     }
 }

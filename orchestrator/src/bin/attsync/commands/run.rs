@@ -3,8 +3,8 @@
 use super::{EngineArgs, HostsArgs, ScenarioArgs, UntilArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
-use attsync::options::StiffnessCheck;
 use attsync::run::{self, RunOptions};
+use attsync::scenario::StiffnessCheck;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 

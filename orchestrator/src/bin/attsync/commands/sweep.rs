@@ -4,8 +4,8 @@
 use super::{EngineArgs, HostsArgs, ScenarioArgs, UntilArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
-use attsync::options::StiffnessCheck;
 use attsync::run::{Engine, RunOptions};
+use attsync::scenario::StiffnessCheck;
 use attsync::sweep::{self, Bisection, SweepOptions};
 use std::path::PathBuf;
 

@@ -3,7 +3,7 @@
 
 use super::ctx::Ctx;
 use super::kind_name;
-use crate::scenario::schema::{ObserverGainsSpec, SchemeKind, SchemeSpec};
+use crate::schema::{ObserverGainsSpec, SchemeKind, SchemeSpec};
 use attitude::control::{ControlGains, ControlLaw};
 use attitude::network::Scheme;
 use attitude::observer::ObserverGains;

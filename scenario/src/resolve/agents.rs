@@ -3,7 +3,7 @@
 use super::ctx::Ctx;
 use super::ids::Ids;
 use super::kind_name;
-use crate::scenario::schema::{AgentSpec, ObserverInit, SchemeKind};
+use crate::schema::{AgentSpec, ObserverInit, SchemeKind};
 use attitude::body::Inertia;
 use attitude::network::AgentState;
 use nalgebra::{Matrix3, Vector3};

@@ -6,7 +6,7 @@
 //! problem, not for each of 10⁵ valid agents.
 
 use super::Issue;
-use crate::scenario::schema::MatrixSpec;
+use crate::schema::MatrixSpec;
 use attitude::checks::{has_distinct_eigenvalues, is_spd, sym_eigenvalues};
 use nalgebra::{Matrix3, Vector3};
 use std::fmt::Display;

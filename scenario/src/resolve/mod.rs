@@ -37,10 +37,9 @@ mod simulation;
 mod stiffness;
 
 pub use ctx::MAX_STEPS;
-pub use stiffness::{REFUSE_FACTOR, WARN_FROM, stable_dt};
+pub use stiffness::{REFUSE_FACTOR, StiffnessCheck, WARN_FROM, stable_dt};
 
 use super::schema::{Output, Scenario, SchemeKind, Simulation};
-use crate::options::StiffnessCheck;
 use attitude::network::{Network, Scheme};
 use attitude::stiffness::{Estimate, Interval};
 use ctx::Ctx;

@@ -2,7 +2,7 @@
 //! time step, the horizon and the exchange schedule, in steps.
 
 use super::ctx::Ctx;
-use crate::scenario::schema::{CouplingKind, Output, Simulation};
+use crate::schema::{CouplingKind, Output, Simulation};
 use attitude::network::Coupling;
 
 /// The time grid of a run; `None` where the field was invalid.

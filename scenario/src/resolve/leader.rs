@@ -2,7 +2,7 @@
 
 use super::ctx::{Ctx, rows};
 use super::kind_name;
-use crate::scenario::schema::{LeaderSpec, ReferenceKind, SchemeKind};
+use crate::schema::{LeaderSpec, ReferenceKind, SchemeKind};
 use attitude::checks::p_is_admissible;
 use nalgebra::{Matrix3, Vector3};
 

@@ -1,5 +1,5 @@
 //! The scenario file format (TOML), as serde types. Unknown keys are
-//! rejected everywhere. See README.md § Scenario format.
+//! rejected everywhere. See `docs/scenarios.md`.
 
 use attitude::control::ControlLaw;
 use serde::{Deserialize, Serialize};
@@ -40,7 +40,7 @@ pub struct Scenario {
     pub guard: GuardSpec,
     /// `[monte_carlo]`: what `attsync mc` disperses (ignored by other commands).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub monte_carlo: Option<crate::mc::MonteCarloSpec>,
+    pub monte_carlo: Option<crate::monte_carlo::MonteCarloSpec>,
 }
 
 /// `[guard]`: the largest norms a node's state may reach before the run

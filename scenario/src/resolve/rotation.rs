@@ -1,7 +1,7 @@
 //! Rotation specs (axis + angle, quaternion, matrix) → rotation matrices.
 
 use super::ctx::{Ctx, rows};
-use crate::scenario::schema::RotationSpec;
+use crate::schema::RotationSpec;
 use attitude::so3::{orthogonality_defect, rot};
 use nalgebra::{Matrix3, Quaternion, UnitQuaternion, Vector3};
 use std::fmt::Display;

@@ -7,11 +7,33 @@
 //! `[`[`WARN_FROM`]`, `[`REFUSE_FACTOR`]`]·dt_max` is warned about.
 
 use super::ctx::Ctx;
-use crate::options::StiffnessCheck;
 use attitude::checks::sym_eigenvalues;
 use attitude::network::{AgentModel, Network, Scheme};
 use attitude::stiffness::{Estimate, Interval, Loop, estimate, psi_gain};
 use nalgebra::Matrix3;
+
+/// What validation does with a `simulation.dt` clearly beyond the largest
+/// stable RK4 step of the scenario's loops (`docs/stiffness.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StiffnessCheck {
+    /// Refuse the scenario (exit code 2), naming a `dt` that would work.
+    #[default]
+    Refuse,
+    /// Only warn (`--no-stiffness-check`): the run goes on and may diverge.
+    Warn,
+}
+
+impl StiffnessCheck {
+    /// The policy of the flag `--no-stiffness-check` (`true` if given).
+    #[must_use]
+    pub fn from_flag(no_stiffness_check: bool) -> Self {
+        if no_stiffness_check {
+            Self::Warn
+        } else {
+            Self::Refuse
+        }
+    }
+}
 
 /// A `dt` above this multiple of the estimated `dt_max` is "clearly beyond"
 /// it and refused. Calibrated on runs (`docs/stiffness.md`, "Calibration"):

@@ -1,3 +1,7 @@
+//! The attsync scenario file format, a crate of its own below the
+//! orchestrator (as cargo keeps `cargo-util-schemas` apart): nothing here
+//! starts a process or knows about runs.
+//!
 //! Scenario files: format ([`schema`]), `--set` overrides ([`overrides`]),
 //! validation and resolution into the model's network ([`resolve`]).
 //!
@@ -19,6 +23,7 @@
 //!   `borrowed` — its fast path: the document read in place, without a copy;
 //! - `document` — [`Document`], the effective TOML a run writes;
 //! - [`resolve`] — validation and resolution into the network, one phase per table;
+//! - [`monte_carlo`] — the `[monte_carlo]` table and its resolution;
 //! - [`plugin`] — plug-in agents (`[[agent]] command`);
 //! - [`report`] — the text `attsync check` prints;
 //! - `error` — [`ScenarioError`].
@@ -28,8 +33,9 @@ pub mod deserialize;
 mod document;
 mod error;
 pub mod input;
+pub mod monte_carlo;
 pub mod overrides;
-pub(crate) mod parse;
+pub mod parse;
 pub mod plugin;
 pub mod report;
 pub mod resolve;
@@ -38,11 +44,10 @@ mod stream;
 
 pub use document::Document;
 pub use error::ScenarioError;
-pub(crate) use error::fmt_issues;
-pub use resolve::{Issue, Resolved};
+pub use error::fmt_issues;
+pub use resolve::{Issue, Resolved, StiffnessCheck};
 pub use schema::Scenario;
 
-use crate::options::StiffnessCheck;
 use std::path::{Path, PathBuf};
 
 /// A scenario as loaded: the effective document (after overrides), its

@@ -4,7 +4,7 @@
 use super::ctx::Ctx;
 use super::graph::{Edges, LeaderLinks};
 use super::ids::Ids;
-use crate::scenario::schema::{LossSpec, NetworkSpec};
+use crate::schema::{LossSpec, NetworkSpec};
 use attitude::link::{LinkModel, Loss, link_seed};
 use std::collections::{BTreeMap, BTreeSet};
 

@@ -42,7 +42,6 @@ pub(super) fn parse(text: &str, sets: &[String]) -> Result<Scenario, Failure> {
     debug!(
         elapsed = ?start.elapsed(),
         ok = typed.is_ok(),
-        peak_rss_kb = msgs::telemetry::peak_rss_kb(),
         "scenario: schema read"
     );
     match typed {
@@ -61,7 +60,7 @@ pub(super) fn parse(text: &str, sets: &[String]) -> Result<Scenario, Failure> {
 /// `text` (TOML, without overrides) as a `T` — another of attsync's files,
 /// e.g. a hosts file — or its syntax error, or every schema problem, each
 /// located in the text as a scenario's are.
-pub(crate) fn typed<T: DeserializeOwned>(text: &str) -> Result<T, Vec<Issue>> {
+pub fn typed<T: DeserializeOwned>(text: &str) -> Result<T, Vec<Issue>> {
     let table: Table = text
         .parse()
         .map_err(|e: toml::de::Error| vec![syntax(text, &e)])?;

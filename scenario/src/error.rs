@@ -47,7 +47,7 @@ pub enum ScenarioError {
 }
 
 /// `issues` of `file`, one line each as `FILE: FIELD: REASON`.
-pub(crate) fn fmt_issues(file: &Path, issues: &[Issue]) -> String {
+pub fn fmt_issues(file: &Path, issues: &[Issue]) -> String {
     issues
         .iter()
         .map(|i| format!("{}: {i}", file.display()))

@@ -3,7 +3,7 @@
 //! with sorted keys), in 32 bytes a node, with keys and strings borrowed
 //! from the text where they need no decoding.
 
-use crate::scenario::overrides::{Tree, TreeValue};
+use crate::overrides::{Tree, TreeValue};
 use serde::ser::{Serialize, SerializeMap, Serializer};
 use std::borrow::Cow;
 use toml::Value;

@@ -3,7 +3,7 @@
 
 use super::ctx::Ctx;
 use super::ids::Ids;
-use crate::scenario::schema::{EdgeSpec, LeaderLinkSpec};
+use crate::schema::{EdgeSpec, LeaderLinkSpec};
 pub(super) use attitude::sparse::Adjacency;
 use nalgebra::Matrix3;
 use std::collections::HashMap;

@@ -2,7 +2,7 @@
 //! finite and > 0.
 
 use super::ctx::Ctx;
-use crate::scenario::schema::GuardSpec;
+use crate::schema::GuardSpec;
 use attitude::guard::Envelope;
 
 /// The envelope of `[guard]`, unset fields at their defaults.
@@ -26,11 +26,11 @@ pub(super) fn guard(c: &mut Ctx, g: &GuardSpec) -> Envelope {
 mod tests {
     use std::path::Path;
 
-    fn load(sets: &[&str]) -> Result<crate::scenario::Loaded, crate::scenario::ScenarioError> {
+    fn load(sets: &[&str]) -> Result<crate::Loaded, crate::ScenarioError> {
         let file =
             Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper/timevarying.toml");
         let sets: Vec<String> = sets.iter().map(|s| (*s).to_string()).collect();
-        crate::scenario::load(&file, &sets)
+        crate::load(&file, &sets)
     }
 
     #[test]

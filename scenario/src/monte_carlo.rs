@@ -9,11 +9,11 @@
 //! leader = false    # also disperse R₀(0) (and ω₀(0), σ₀(0) of a time-varying leader)
 //! ```
 //! Attitudes are drawn Haar-uniformly on SO(3), vectors with a uniform
-//! direction ([`super::haar`]). Every field can be set from the command
+//! direction (the orchestrator's `mc::haar`). Every field can be set from the command
 //! line like any other (`--set monte_carlo.omega_max=2`).
 
-use crate::scenario::Issue;
-use crate::scenario::schema::{ReferenceKind, Scenario, SchemeKind};
+use crate::Issue;
+use crate::schema::{ReferenceKind, Scenario, SchemeKind};
 use serde::{Deserialize, Serialize};
 
 /// Default `omega_max`, rad/s.
@@ -176,7 +176,7 @@ fn checked(list: &[Quantity], kind: SchemeKind, issues: &mut Vec<Issue>) -> Vec<
                 format!(
                     "`{}`: scheme {} has no such initial value",
                     q.name(),
-                    crate::scenario::resolve::kind_name(kind)
+                    crate::resolve::kind_name(kind)
                 ),
             ));
         } else if out.contains(&q) {
