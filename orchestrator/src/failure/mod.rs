@@ -46,8 +46,28 @@ pub enum Failure {
         /// What it did.
         how: String,
     },
-    /// The telemetry could not be read, or its samples did not fit together.
+    /// The telemetry could not be received (iceoryx2's error, its text).
     Telemetry(String),
+    /// A node's telemetry message does not decode.
+    Undecodable {
+        /// The node id it claims.
+        node: u32,
+        /// Why it does not decode.
+        why: String,
+    },
+    /// A node's sample is not at the leader's step.
+    OutOfStep {
+        /// The node's name.
+        node: String,
+        /// Its step.
+        step: u64,
+        /// The leader's.
+        leader: u64,
+    },
+    /// The leader sent an agent's sample.
+    LeaderSentAgentSample,
+    /// An agent (its name) sent the leader's sample.
+    AgentSentLeaderSample(String),
     /// A state left the envelope: where, once the run has said it
     /// ([`attitude::guard::Divergence::message`]; the engines say `diverged`).
     Diverged(Option<String>),
@@ -133,6 +153,13 @@ impl fmt::Display for Failure {
             }
             Failure::BrokeProtocol { node, how } => write!(f, "{node} broke the protocol: {how}"),
             Failure::Telemetry(what) | Failure::Recorded(what) => f.write_str(what),
+            Failure::Undecodable { node, why } => write!(f, "node {node}'s telemetry: {why}"),
+            Failure::OutOfStep { node, step, leader } => write!(
+                f,
+                "telemetry out of step: {node} at step {step}, leader at {leader}"
+            ),
+            Failure::LeaderSentAgentSample => f.write_str("the leader sent an agent's sample"),
+            Failure::AgentSentLeaderSample(node) => write!(f, "{node} sent the leader's sample"),
             Failure::Diverged(None) => f.write_str("diverged"),
             Failure::Diverged(Some(message)) => f.write_str(message),
             Failure::WriterStopped => f.write_str("stopped by the results writer"),
@@ -195,5 +222,14 @@ mod tests {
             "nodes failed at shutdown: leader: exit code 1; agent-2: x"
         );
         assert_eq!(shut.exit_code(), 1);
+        let late = Failure::OutOfStep {
+            node: "agent-2".into(),
+            step: 30,
+            leader: 20,
+        };
+        assert_eq!(
+            late.to_string(),
+            "telemetry out of step: agent-2 at step 30, leader at 20"
+        );
     }
 }

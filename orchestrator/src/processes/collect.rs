@@ -129,9 +129,10 @@ impl Collector {
                 how: format!("its telemetry claims to come from node {}", m.sender),
             });
         }
-        let t = m
-            .decode()
-            .map_err(|e| Failure::Telemetry(format!("node {}'s telemetry: {e}", m.sender)))?;
+        let t = m.decode().map_err(|e| Failure::Undecodable {
+            node: m.sender,
+            why: e.to_string(),
+        })?;
         self.take(i, t)
     }
 
@@ -271,10 +272,11 @@ impl Collector {
             return Ok(None);
         }
         if let Some(s) = self.slots.iter().find(|s| s.pending[0].0 != step) {
-            return Err(Failure::Telemetry(format!(
-                "telemetry out of step: {} at step {}, leader at {step}",
-                s.name, s.pending[0].0
-            )));
+            return Err(Failure::OutOfStep {
+                node: s.name.clone(),
+                step: s.pending[0].0,
+                leader: step,
+            });
         }
         let mut samples = (self.slots.iter_mut()).map(|s| {
             let sample = s.pending.pop_front().expect("non-empty").1;
@@ -284,16 +286,12 @@ impl Collector {
             (s.name.as_str(), sample)
         });
         let Some((_, Sampled::Leader(leader))) = samples.next() else {
-            return Err(Failure::Telemetry(
-                "the leader sent an agent's sample".into(),
-            ));
+            return Err(Failure::LeaderSentAgentSample);
         };
         let agents = samples
             .map(|(name, s)| match s {
                 Sampled::Agent(a, _) => Ok(a),
-                Sampled::Leader(_) => Err(Failure::Telemetry(format!(
-                    "{name} sent the leader's sample"
-                ))),
+                Sampled::Leader(_) => Err(Failure::AgentSentLeaderSample(name.to_string())),
             })
             .collect::<Result<_, _>>()?;
         Ok(Some((step, leader, agents)))
