@@ -129,3 +129,99 @@ fn the_edge_reader_finds_names_and_groups_and_a_circle() {
     let c = circle(&graph, "a", &mut vec!["a".to_string()]);
     assert_eq!(c, Some(vec!["a".into(), "b".into(), "c".into()]));
 }
+
+/// The workspace's crates (each directory with a `Cargo.toml` beside
+/// `orchestrator/`), but not `examples/` (a user's programs) nor `fuzz/`.
+fn workspace_sources() -> Vec<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut out = Vec::new();
+    for entry in fs::read_dir(&root).expect("the workspace is readable") {
+        let dir = entry.expect("an entry").path();
+        let name = dir
+            .file_name()
+            .expect("a name")
+            .to_string_lossy()
+            .into_owned();
+        if dir.join("Cargo.toml").is_file()
+            && !["examples", "fuzz", "target"].contains(&name.as_str())
+        {
+            for sub in ["src", "tests", "benches"] {
+                if dir.join(sub).is_dir() {
+                    out.extend(rust_files(&dir.join(sub)));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Each `Result<…>` in `code` whose error type (its last top-level
+/// argument) is `String`.
+fn string_results(code: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for (at, _) in code.match_indices("Result<") {
+        let args = &code[at + "Result<".len()..];
+        let (mut depth, mut last, mut end) = (1, 0, None);
+        for (k, c) in args.char_indices() {
+            match c {
+                '<' | '(' | '[' => depth += 1,
+                '>' | ')' | ']' => depth -= 1,
+                ',' if depth == 1 => last = k + 1,
+                _ => {}
+            }
+            if depth == 0 {
+                end = Some(k);
+                break;
+            }
+        }
+        if let Some(end) = end
+            && last > 0
+            && args[last..end].trim() == "String"
+        {
+            out.push(format!("Result<{}>", &args[..end]));
+        }
+    }
+    out
+}
+
+#[test]
+fn no_failure_is_a_string() {
+    let mut found = Vec::new();
+    for file in workspace_sources() {
+        let text = fs::read_to_string(&file).expect("a readable file");
+        let code: String = (text.lines())
+            .filter(|l| !l.trim_start().starts_with("//"))
+            .collect::<Vec<_>>()
+            .join(" ");
+        for r in string_results(&code) {
+            found.push(format!("{}: {r}", file.display()));
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "errors as strings (use a thiserror enum):\n{}",
+        found.join("\n")
+    );
+    assert_eq!(
+        string_results(
+            "fn f() -> Result<Vec<(u8, String)>,\n String> {} fn g() -> Result<(), E> {}"
+        ),
+        ["Result<Vec<(u8, String)>,\n String>"]
+    );
+}
+
+#[test]
+fn the_engine_phases_do_not_know_where_a_node_runs() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/processes");
+    for file in rust_files(&dir) {
+        let text = fs::read_to_string(&file).expect("a readable file");
+        let code = text.lines().filter(|l| !l.trim_start().starts_with("//"));
+        for line in code {
+            assert!(
+                !line.contains("remote") && !line.contains("hosts::"),
+                "{}: the engine names the remote: {line}",
+                file.display()
+            );
+        }
+    }
+}
