@@ -14,12 +14,12 @@
 //!   threads and command line;
 //! - [`rusage`]: the CPU time and peak memory of this process;
 //! - [`affinity`]: the cores a thread may run on;
-//! - [`slice`]: the time slice a thread asks the scheduler for;
+//! - [`timeslice`]: the time slice a thread asks the scheduler for;
 //! - [`pdeath`]: a child that dies with its parent;
 //! - [`machine`] and [`limits`]: what the machine is and what it allows.
 //!
 //! The crate is a leaf (`std`, `libc`, `nix`, `thiserror`): the two system
-//! calls of [`slice`] have no safe wrapper in `libc` or `nix`; they and
+//! calls of [`timeslice`] have no safe wrapper in `libc` or `nix`; they and
 //! [`pdeath`] (a hook between `fork` and `exec`, unsafe by nature) are the
 //! workspace's only unsafe code.
 
@@ -32,9 +32,9 @@ pub mod pdeath;
 pub mod process;
 pub mod rusage;
 pub mod schedstat;
-pub mod slice;
 pub mod stat;
 pub mod status;
 pub mod times;
+pub mod timeslice;
 
 pub use error::ProcError;

@@ -107,9 +107,11 @@ mod tests {
     }
 
     #[test]
-    fn this_process_is_read() {
+    fn stat_is_parsed_past_the_command_name() {
         let me = own().expect("own stat");
+        let pgrp = nix::unistd::getpgrp().as_raw();
         assert_eq!(me.ppid, std::os::unix::process::parent_id());
+        assert_eq!(i32::try_from(me.pgrp), Ok(pgrp));
         assert!(!me.is_dead());
     }
 }
