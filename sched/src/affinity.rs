@@ -25,9 +25,9 @@ pub enum AffinityError {
     },
 }
 
-/// The kernel's pid type for `tid` (a tid always fits: Linux caps them at 2²²).
+/// Thread `tid` as `nix` names it.
 fn pid(tid: u32) -> Pid {
-    Pid::from_raw(i32::try_from(tid).unwrap_or(i32::MAX))
+    Pid::from_raw(crate::kernel_id(tid))
 }
 
 /// The cores thread `tid` may run on (0: the calling thread), ascending.

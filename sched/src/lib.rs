@@ -38,3 +38,9 @@ pub mod times;
 pub mod timeslice;
 
 pub use error::ProcError;
+
+/// A pid or thread id as the kernel's type (one always fits: Linux caps
+/// them at 2²²).
+pub(crate) fn kernel_id(id: u32) -> libc::pid_t {
+    libc::pid_t::try_from(id).unwrap_or(libc::pid_t::MAX)
+}

@@ -36,7 +36,7 @@ pub enum SliceError {
     #[error("reading the scheduling attributes of thread {tid}: {source}")]
     Get {
         /// The thread.
-        tid: i32,
+        tid: u32,
         /// The system's reason.
         source: std::io::Error,
     },
@@ -44,7 +44,7 @@ pub enum SliceError {
     #[error("setting the time slice of thread {tid}: {source}")]
     Set {
         /// The thread.
-        tid: i32,
+        tid: u32,
         /// The system's reason.
         source: std::io::Error,
     },
@@ -84,7 +84,7 @@ const SCHED_IDLE: u32 = 5;
 const SCHED_FLAG_RESET_ON_FORK: u64 = 0x01;
 
 /// The scheduling attributes of thread `tid` (0: the calling thread).
-fn get(tid: i32) -> Result<SchedAttr, SliceError> {
+fn get(tid: u32) -> Result<SchedAttr, SliceError> {
     let mut attr = SchedAttr::default();
     let size = std::mem::size_of::<SchedAttr>() as u32;
     // SAFETY: `attr` is a valid, writable `struct sched_attr` of `size`
@@ -93,7 +93,7 @@ fn get(tid: i32) -> Result<SchedAttr, SliceError> {
     let r = unsafe {
         libc::syscall(
             libc::SYS_sched_getattr,
-            tid,
+            crate::kernel_id(tid),
             &raw mut attr,
             size,
             0 as libc::c_uint,
@@ -111,7 +111,7 @@ fn get(tid: i32) -> Result<SchedAttr, SliceError> {
 /// The time slice of thread `tid` (0: the calling thread): the one it asked
 /// for, else the kernel's default (Linux ≥ 6.12 reports both; older kernels
 /// report none), or `None` under a policy that has no slice.
-pub fn slice_of(tid: i32) -> Result<Option<Duration>, SliceError> {
+pub fn slice_of(tid: u32) -> Result<Option<Duration>, SliceError> {
     let attr = get(tid)?;
     let fair = matches!(attr.sched_policy, SCHED_OTHER | SCHED_BATCH | SCHED_IDLE);
     Ok((fair && attr.sched_runtime > 0).then(|| Duration::from_nanos(attr.sched_runtime)))
@@ -121,7 +121,7 @@ pub fn slice_of(tid: i32) -> Result<Option<Duration>, SliceError> {
 /// thread), or for the kernel's default if `None`, keeping its policy and
 /// nice value. A thread under a real-time policy is left alone. Threads it
 /// creates later inherit the slice.
-pub fn set_slice(tid: i32, slice: Option<Duration>) -> Result<(), SliceError> {
+pub fn set_slice(tid: u32, slice: Option<Duration>) -> Result<(), SliceError> {
     let mut attr = get(tid)?;
     if !matches!(attr.sched_policy, SCHED_OTHER | SCHED_BATCH | SCHED_IDLE) {
         return Ok(());
@@ -138,7 +138,7 @@ pub fn set_slice(tid: i32, slice: Option<Duration>) -> Result<(), SliceError> {
     let r = unsafe {
         libc::syscall(
             libc::SYS_sched_setattr,
-            tid,
+            crate::kernel_id(tid),
             &raw const attr,
             0 as libc::c_uint,
         )
@@ -207,7 +207,7 @@ mod tests {
             .arg("30")
             .spawn()
             .expect("sleep");
-        let tid = i32::try_from(child.id()).expect("pid");
+        let tid = child.id();
         let set = set_slice(tid, Some(SHORT_SLICE));
         let slice = slice_of(tid);
         let _ = child.kill();
@@ -225,7 +225,7 @@ mod tests {
     #[test]
     fn a_thread_that_is_gone_is_named_with_the_systems_reason() {
         let mut child = std::process::Command::new("true").spawn().expect("true");
-        let tid = i32::try_from(child.id()).expect("pid");
+        let tid = child.id();
         child.wait().expect("wait");
         match set_slice(tid, Some(SHORT_SLICE)) {
             Err(SliceError::Get { tid: t, source }) => {

@@ -122,10 +122,7 @@ pub fn least_busy(w: &Window) -> Option<usize> {
 fn apply(pid: u32, cores: &[usize], slice: Option<Duration>) {
     for tid in process::threads(pid) {
         let _ = affinity::set(tid, cores);
-        let Ok(id) = i32::try_from(tid) else {
-            continue;
-        };
-        if let Err(e) = attsync_sched::timeslice::set_slice(id, slice) {
+        if let Err(e) = attsync_sched::timeslice::set_slice(tid, slice) {
             tracing::debug!(pid, tid, "time slice unchanged: {e}");
         }
     }
@@ -238,15 +235,11 @@ pub fn pin(pids: &[u32], adjacency: &[Vec<usize>]) {
 /// short time slices ([`slice`]), spread the kernel's default again.
 pub(super) fn place(pids: &[u32], placed: Placed, cores: &Cores) {
     for (k, &pid) in pids.iter().enumerate() {
-        let only;
         let set = match (placed, cores.pinned.get(k)) {
-            (Placed::Spread, None) => &cores.list[..],
-            (Placed::Spread, Some(&core)) | (Placed::Packed(core), _) => {
-                only = [core];
-                &only[..]
-            }
+            (Placed::Spread, None) => cores.list.clone(),
+            (Placed::Spread, Some(&core)) | (Placed::Packed(core), _) => vec![core],
         };
-        apply(pid, set, slice(placed));
+        apply(pid, &set, slice(placed));
     }
 }
 
@@ -325,8 +318,7 @@ mod tests {
 
     /// The CPUs process `pid` may run on, and its slice.
     fn placed(pid: u32) -> (Vec<usize>, Option<Duration>) {
-        let tid = i32::try_from(pid).expect("pid");
-        let slice = attsync_sched::timeslice::slice_of(tid).expect("slice");
+        let slice = attsync_sched::timeslice::slice_of(pid).expect("slice");
         (affinity::of(pid).expect("affinity"), slice)
     }
 
