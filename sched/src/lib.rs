@@ -11,7 +11,7 @@
 //! - [`busy`]: the one definition of a busy core, for the placement and the
 //!   benchmark alike;
 //! - [`process`]: whether a process lives, its group, its children, its
-//!   threads and command line;
+//!   threads and command line; [`reap`]: adopting and killing orphans;
 //! - [`rusage`]: the CPU time and peak memory of this process;
 //! - [`affinity`]: the cores a thread may run on;
 //! - [`timeslice`]: the time slice a thread asks the scheduler for;
@@ -30,6 +30,7 @@ pub mod limits;
 pub mod machine;
 pub mod pdeath;
 pub mod process;
+pub mod reap;
 pub mod rusage;
 pub mod schedstat;
 pub mod stat;

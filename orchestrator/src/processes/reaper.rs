@@ -9,9 +9,7 @@
 //! the nodes it still supervises have all been waited for by then; children
 //! it spawned itself outside runs stay in its group and are left alone).
 
-use nix::sys::signal::{Signal, kill};
-use nix::sys::wait::waitpid;
-use nix::unistd::Pid;
+use attsync_sched::{process, reap};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Processes-engine runs going on in this process.
@@ -26,7 +24,7 @@ impl Reaper {
     /// Makes this process a child subreaper (best effort) and counts the run.
     #[must_use]
     pub fn start() -> Self {
-        let _ = nix::sys::prctl::set_child_subreaper(true);
+        let _ = reap::become_subreaper();
         ACTIVE.fetch_add(1, Ordering::SeqCst);
         Self(())
     }
@@ -45,14 +43,12 @@ impl Drop for Reaper {
 pub fn kill_orphans() -> usize {
     let mut killed = 0;
     for _ in 0..16 {
-        let orphans = attsync_sched::process::children_outside_own_group();
+        let orphans = process::children_outside_own_group();
         if orphans.is_empty() {
             break;
         }
         for pid in orphans {
-            let pid = Pid::from_raw(i32::try_from(pid).unwrap_or(i32::MAX));
-            let _ = kill(pid, Signal::SIGKILL);
-            let _ = waitpid(pid, None);
+            reap::kill_and_reap(pid);
             killed += 1;
         }
     }
