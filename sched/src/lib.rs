@@ -1,6 +1,6 @@
 //! Everything attsync asks of the operating system (Linux), in one place:
 //! the system calls and the `/proc` reads of the orchestrator's library, its
-//! benchmark and its nodes. Nothing else in the workspace parses `/proc`.
+//! benchmark and its nodes. Nothing else in them reads `/proc`.
 //!
 //! Each module holds one concept:
 //!
