@@ -25,46 +25,20 @@ pub fn median_u64(values: &[u64]) -> Option<u64> {
     v.get(v.len().saturating_sub(1) / 2).copied()
 }
 
-/// Clock ticks per second of `/proc` CPU times (Linux uses 100).
-const TICKS: f64 = 100.0;
+/// Clock ticks per second of `/proc` CPU times.
+const TICKS: f64 = attsync_sched::times::USER_HZ as f64;
 
+/// Ticks every core was busy (the workspace's one definition of busy:
+/// [`attsync_sched::busy`]).
 fn machine_busy_ticks() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/stat").ok()?;
-    let f: Vec<u64> = text
-        .lines()
-        .next()?
-        .split_whitespace()
-        .skip(1)
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    // user nice system idle iowait irq softirq steal …: all but idle and iowait.
-    Some(f.iter().take(8).sum::<u64>() - f.get(3)? - f.get(4)?)
-}
-
-/// The numeric fields of `/proc/self/stat` after the command name (which
-/// ends with ')'): element 0 is field 3, so utime, stime, cutime, cstime
-/// (fields 14..17) are elements 11..14.
-fn self_stat() -> Option<Vec<u64>> {
-    let text = std::fs::read_to_string("/proc/self/stat").ok()?;
-    let rest = &text[text.rfind(')')? + 2..];
-    Some(
-        rest.split_whitespace()
-            .map(|x| x.parse().unwrap_or(0))
-            .collect(),
-    )
-}
-
-fn own_ticks() -> Option<u64> {
-    let f = self_stat()?;
-    Some(f.get(11)? + f.get(12)? + f.get(13)? + f.get(14)?)
+    Some(attsync_sched::times::read_now().ok()?.all.busy())
 }
 
 /// CPU time this process has used so far (user + system, every thread,
 /// finished ones included), s; `/proc` resolution (10 ms).
 #[must_use]
 pub fn cpu_seconds() -> Option<f64> {
-    let f = self_stat()?;
-    Some((f.get(11)? + f.get(12)?) as f64 / TICKS)
+    attsync_sched::rusage::cpu_time().map(|t| t.as_secs_f64())
 }
 
 /// Measures how busy the machine was with *other* work during a
@@ -83,7 +57,7 @@ impl CpuMeter {
     pub fn start() -> Self {
         Self {
             busy: machine_busy_ticks(),
-            mine: own_ticks(),
+            mine: attsync_sched::rusage::cpu_ticks_with_children(),
             t0: std::time::Instant::now(),
         }
     }
@@ -93,7 +67,7 @@ impl CpuMeter {
     #[must_use]
     pub fn foreign_cores(&self) -> Option<f64> {
         let busy = machine_busy_ticks()?.checked_sub(self.busy?)?;
-        let mine = own_ticks()?.checked_sub(self.mine?)?;
+        let mine = attsync_sched::rusage::cpu_ticks_with_children()?.checked_sub(self.mine?)?;
         let wall = self.t0.elapsed().as_secs_f64();
         (wall > 0.0).then(|| (busy as f64 - mine as f64).max(0.0) / TICKS / wall)
     }
@@ -120,38 +94,20 @@ pub fn wait_idle(threshold: f64, max: std::time::Duration) -> bool {
 /// `nproc`, CPU model, RAM.
 #[must_use]
 pub fn machine() -> String {
+    use attsync_sched::machine;
     let cpus = std::thread::available_parallelism().map_or(0, std::num::NonZero::get);
-    let model = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|t| {
-            t.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, v)| v.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".into());
-    let ram_kb = std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|t| {
-            t.lines()
-                .find(|l| l.starts_with("MemTotal:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|v| v.parse::<u64>().ok())
-        })
-        .unwrap_or(0);
+    let model = machine::cpu_model().unwrap_or_else(|| "unknown CPU".into());
+    let ram = machine::mem_total().unwrap_or(0);
     format!(
         "{cpus} CPUs (nproc), {model}, {:.1} GiB RAM",
-        ram_kb as f64 / 1024.0 / 1024.0
+        ram as f64 / 1024.0 / 1024.0 / 1024.0
     )
 }
 
 /// The 1-, 5- and 15-minute load averages.
 #[must_use]
 pub fn loadavg() -> String {
-    std::fs::read_to_string("/proc/loadavg")
-        .ok()
-        .map(|t| t.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
-        .unwrap_or_else(|| "?".into())
+    attsync_sched::machine::load_averages().unwrap_or_else(|| "?".into())
 }
 
 #[cfg(test)]

@@ -47,17 +47,7 @@ pub fn watched() -> Result<u32, Orphaned> {
 
 /// Whether process `pid` exists and is not a zombie (a killed process stays
 /// a zombie until its own parent reaps it: it is gone all the same).
-#[must_use]
-pub fn alive(pid: u32) -> bool {
-    let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else {
-        return false;
-    };
-    // `pid (comm) state …`: the command name may hold spaces and parentheses.
-    let state = stat
-        .rfind(')')
-        .and_then(|i| stat[i + 1..].split_whitespace().next());
-    !matches!(state, Some("Z" | "X") | None)
-}
+pub use attsync_sched::process::alive;
 
 #[cfg(test)]
 mod tests {

@@ -421,19 +421,8 @@ impl Reader<'_> {
     }
 }
 
-/// Peak resident set size of this process (VmHWM), kB; 0 if unknown.
-#[must_use]
-pub fn peak_rss_kb() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|v| v.parse().ok())
-        })
-        .unwrap_or(0)
-}
+/// Peak resident set size of this process (`VmHWM`), kB; 0 if unknown.
+pub use attsync_sched::rusage::peak_rss_kb;
 
 #[cfg(test)]
 mod tests {

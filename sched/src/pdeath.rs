@@ -24,7 +24,7 @@ pub const ORPHANED_AT_BIRTH: i32 = 1;
 /// in the child (`prctl`, `getppid`, `_exit`).
 pub fn die_with_parent(cmd: &mut Command) -> &mut Command {
     // The pid the child must find as its parent: ours, read before the fork.
-    let parent = nix_pid(std::process::id());
+    let parent = crate::kernel_id(std::process::id());
     // SAFETY: the closure runs in the child between fork and exec, and only
     // makes the system calls prctl, getppid and _exit, which are
     // async-signal-safe; it allocates nothing and takes no lock.
@@ -41,11 +41,6 @@ pub fn die_with_parent(cmd: &mut Command) -> &mut Command {
             Ok(())
         })
     }
-}
-
-/// A pid as the kernel's type (a pid always fits: Linux caps them at 2²²).
-fn nix_pid(pid: u32) -> libc::pid_t {
-    libc::pid_t::try_from(pid).unwrap_or(libc::pid_t::MAX)
 }
 
 #[cfg(test)]

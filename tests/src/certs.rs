@@ -67,7 +67,7 @@ fn remove_stale(root: &Path) {
     };
     for e in rd.filter_map(Result::ok) {
         let name = e.file_name().to_string_lossy().into_owned();
-        if !Path::new("/proc").join(&name).exists() {
+        if !name.parse().is_ok_and(attsync_sched::process::exists) {
             let _ = std::fs::remove_dir_all(e.path());
         }
     }

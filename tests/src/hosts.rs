@@ -17,6 +17,7 @@
 
 use crate::netns::Veth;
 use crate::{Sandbox, wait_until};
+use attsync_sched::process::{self, mount_namespace};
 use std::collections::BTreeSet;
 use std::fs::{self, File};
 use std::io::{BufRead, BufReader};
@@ -109,7 +110,7 @@ impl HostSandbox {
             );
         }
         let namespace = mount_namespace(holder.id()).expect("the holder's mount namespace");
-        let ours = fs::read_link("/proc/self/ns/mnt").expect("this process's mount namespace");
+        let ours = mount_namespace(std::process::id()).expect("this process's mount namespace");
         assert_ne!(
             namespace, ours,
             "host sandbox `{name}`: the holder shares our mount namespace"
@@ -194,10 +195,7 @@ impl HostSandbox {
     /// The names in this host's `/dev/shm` (what its processes left there).
     #[must_use]
     pub fn shm_entries(&self) -> BTreeSet<String> {
-        entries(&PathBuf::from(format!(
-            "/proc/{}/root/dev/shm",
-            self.holder.id()
-        )))
+        entries(&process::root(self.holder.id()).join("dev/shm"))
     }
 
     /// The names in this host's `TMPDIR`.
@@ -210,10 +208,7 @@ impl HostSandbox {
     #[must_use]
     pub fn processes(&self) -> Vec<u32> {
         let holder = self.holder.id();
-        let Ok(proc) = fs::read_dir("/proc") else {
-            return Vec::new();
-        };
-        proc.filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        (process::pids().into_iter())
             .filter(|&pid| pid != holder)
             .filter(|&pid| mount_namespace(pid).as_ref() == Some(&self.namespace))
             .collect()
@@ -333,11 +328,6 @@ fn ready(holder: &mut Child) -> bool {
     });
     rx.recv_timeout(SETUP_TIMEOUT)
         .is_ok_and(|line| line.trim() == READY)
-}
-
-/// The mount namespace of `pid` (`None`: gone, or a zombie).
-fn mount_namespace(pid: u32) -> Option<PathBuf> {
-    fs::read_link(format!("/proc/{pid}/ns/mnt")).ok()
 }
 
 /// `kill -KILL -- targets…` (pids, or `-pgid` for a group), its failures

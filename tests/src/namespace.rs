@@ -2,6 +2,7 @@
 //! an `owner` file holding the orchestrator's pid, shared memory
 //! `/dev/shm/as<run>_*`), the node processes of a run, and signals.
 
+use attsync_sched::process::{self, cmdline};
 use std::collections::BTreeSet;
 use std::ffi::OsStr;
 use std::fs;
@@ -99,28 +100,12 @@ pub fn run_leftovers(run: &str) -> Vec<PathBuf> {
     out
 }
 
-/// The command line of process `pid` (empty if it is gone).
-fn cmdline(pid: u32) -> Vec<String> {
-    fs::read(format!("/proc/{pid}/cmdline"))
-        .map(|b| {
-            b.split(|&c| c == 0)
-                .filter(|a| !a.is_empty())
-                .map(|a| String::from_utf8_lossy(a).into_owned())
-                .collect()
-        })
-        .unwrap_or_default()
-}
-
 /// Live processes (pid, command line) with an argument inside run `run`'s
 /// root directory: the node processes, started with `--config <root>/node-<id>.json`.
 #[must_use]
 pub fn run_processes(run: &str) -> Vec<(u32, Vec<String>)> {
     let needle = format!("{}/", iox_base().join(run).display());
-    let Ok(rd) = fs::read_dir("/proc") else {
-        return Vec::new();
-    };
-    rd.filter_map(Result::ok)
-        .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
+    (process::pids().into_iter())
         .filter_map(|pid| {
             let args = cmdline(pid);
             args.iter()
@@ -164,15 +149,10 @@ pub fn node_pid(run: &str, id: u32) -> Option<u32> {
 pub fn started_by(parent: u32) -> Vec<u32> {
     let var = format!("{}={parent}", msgs::parent::PARENT_PID_VAR);
     let dir = format!("{}/{parent:x}r", iox_base().display());
-    let Ok(rd) = fs::read_dir("/proc") else {
-        return Vec::new();
-    };
-    rd.filter_map(Result::ok)
-        .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
+    (process::pids().into_iter())
         .filter(|&pid| {
             // (A zombie's environment and command line read empty.)
-            let env = fs::read(format!("/proc/{pid}/environ")).unwrap_or_default();
-            let by_env = env.split(|&c| c == 0).any(|kv| kv == var.as_bytes());
+            let by_env = process::environ(pid).iter().any(|kv| kv == var.as_bytes());
             by_env || cmdline(pid).iter().any(|a| a.starts_with(&dir))
         })
         .collect()

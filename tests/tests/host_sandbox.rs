@@ -27,10 +27,7 @@ fn sh(host: &mut HostSandbox, script: &str) -> String {
 
 /// Whether process `pid` is gone (or a zombie, dead but not reaped).
 fn gone(pid: u32) -> bool {
-    fs::read_to_string(format!("/proc/{pid}/stat")).map_or(true, |s| {
-        s.rsplit_once(')')
-            .is_some_and(|(_, rest)| rest.trim_start().starts_with('Z'))
-    })
+    !attsync_sched::process::alive(pid)
 }
 
 /// `sh -c script` started in `host`, and the number its first line of

@@ -23,14 +23,9 @@ fn run(tmp: &Sandbox, scenario: &Path, out: &Path) -> Finished {
 
 /// Pids of processes whose command line has an argument equal to `arg`.
 fn processes_with_arg(arg: &str) -> Vec<u32> {
-    std::fs::read_dir("/proc")
-        .unwrap()
-        .filter_map(Result::ok)
-        .filter_map(|e| e.file_name().to_str()?.parse::<u32>().ok())
-        .filter(|pid| {
-            std::fs::read(format!("/proc/{pid}/cmdline"))
-                .is_ok_and(|c| c.split(|&b| b == 0).any(|a| a == arg.as_bytes()))
-        })
+    use attsync_sched::process::{cmdline, pids};
+    (pids().into_iter())
+        .filter(|&pid| cmdline(pid).iter().any(|a| a == arg))
         .collect()
 }
 

@@ -7,7 +7,7 @@
 //! changes what a node computes: results are byte-identical.
 //!
 //! Packed, every thread of every node asks for short time slices
-//! (`attsync_sched::SHORT_SLICE`, Linux ≥ 6.12); spread, the kernel's
+//! (`attsync_sched::timeslice::SHORT_SLICE`, Linux ≥ 6.12); spread, the kernel's
 //! default.
 //!
 //! The test reads each node's allowed CPUs from `/proc/<pid>/status`
@@ -39,11 +39,10 @@ struct Placed {
 /// Where node `id` of `run` may run, and its slice.
 fn placed(run: &str, id: u32) -> Option<Placed> {
     let pid = node_pid(run, id)?;
-    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
-    let cpus = status
-        .lines()
-        .find_map(|l| l.strip_prefix("Cpus_allowed_list:"))
-        .map(|s| s.trim().to_string())?;
+    let status = attsync_sched::status::of(pid).ok()?;
+    let cpus = attsync_sched::status::field(&status, "Cpus_allowed_list")?.to_string();
+    // The slice as the kernel reports it, a witness independent of the
+    // system call the orchestrator made.
     let sched = std::fs::read_to_string(format!("/proc/{pid}/sched")).ok()?;
     let slice_ns = sched.lines().find_map(|l| {
         l.strip_prefix("se.slice")?
@@ -66,13 +65,13 @@ fn placed_all(run: &str) -> Option<Vec<Placed>> {
 
 /// Every node asked for short slices (where the kernel has them).
 fn short_slices(nodes: &[Placed]) -> bool {
-    let short = u64::try_from(attsync_sched::SHORT_SLICE.as_nanos()).expect("ns");
-    !attsync_sched::custom_slices() || nodes.iter().all(|n| n.slice_ns == Some(short))
+    let short = u64::try_from(attsync_sched::timeslice::SHORT_SLICE.as_nanos()).expect("ns");
+    !attsync_sched::timeslice::custom_slices() || nodes.iter().all(|n| n.slice_ns == Some(short))
 }
 
 /// No node asked for short slices.
 fn default_slices(nodes: &[Placed]) -> bool {
-    let short = u64::try_from(attsync_sched::SHORT_SLICE.as_nanos()).expect("ns");
+    let short = u64::try_from(attsync_sched::timeslice::SHORT_SLICE.as_nanos()).expect("ns");
     nodes.iter().all(|n| n.slice_ns != Some(short))
 }
 

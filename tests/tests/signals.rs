@@ -127,11 +127,8 @@ fn sigint_stops_a_process_run_with_130() {
 
 /// Whether process `pid` has a thread named `name` (its `comm`).
 fn has_thread(pid: u32, name: &str) -> bool {
-    std::fs::read_dir(format!("/proc/{pid}/task"))
-        .into_iter()
-        .flatten()
-        .flatten()
-        .any(|t| std::fs::read_to_string(t.path().join("comm")).is_ok_and(|c| c.trim() == name))
+    use attsync_sched::process::{thread_name, threads};
+    (threads(pid).into_iter()).any(|tid| thread_name(pid, tid).is_some_and(|c| c.trim() == name))
 }
 
 /// A signal before anything is written — here attsync is blocked opening

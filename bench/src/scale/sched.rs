@@ -1,5 +1,5 @@
 //! Where a measurement's threads spent their time, from the scheduler's own
-//! books (`/proc/self/task/<tid>/schedstat`: nanoseconds on a CPU, and
+//! books ([`attsync_sched::schedstat`]: nanoseconds on a CPU, and
 //! nanoseconds runnable but waiting for one), without `perf`.
 //!
 //! The engine's worker threads live only while [`attitude::engine::InProcess::run`]
@@ -89,37 +89,19 @@ impl Watch {
 /// a task's first figures are what it had at the watch's start, or zero
 /// for a task started since (so its whole life is booked).
 fn sample(seen: &Mutex<Seen>, at_start: bool) {
-    let Ok(dir) = std::fs::read_dir("/proc/self/task") else {
-        return;
-    };
-    let now: Vec<(u32, (u64, u64))> = dir
-        .flatten()
-        .filter_map(|e| {
-            let tid = e.file_name().to_str()?.parse().ok()?;
-            Some((tid, schedstat(&e.path().join("schedstat"))?))
-        })
-        .collect();
+    let now = attsync_sched::schedstat::of_threads(std::process::id());
     let mut seen = seen.lock().unwrap_or_else(|e| e.into_inner());
-    for (tid, figures) in now {
+    for (tid, s) in now {
+        let figures = (s.on_cpu_ns, s.waiting_ns);
         seen.entry(tid)
             .and_modify(|(_, last)| *last = figures)
             .or_insert((if at_start { figures } else { (0, 0) }, figures));
     }
 }
 
-/// `(ns on a CPU, ns waiting)` of one task.
-fn schedstat(file: &std::path::Path) -> Option<(u64, u64)> {
-    let text = std::fs::read_to_string(file).ok()?;
-    let mut f = text.split_whitespace().map(|x| x.parse::<u64>().ok());
-    Some((f.next()??, f.next()??))
-}
-
-/// The calling thread's task id (`/proc/thread-self` names it).
+/// The calling thread's task id (0 if unknown).
 fn own_tid() -> u32 {
-    std::fs::read_link("/proc/thread-self")
-        .ok()
-        .and_then(|p| p.file_name()?.to_str()?.parse().ok())
-        .unwrap_or(0)
+    attsync_sched::process::current_thread().unwrap_or(0)
 }
 
 #[cfg(test)]

@@ -175,7 +175,7 @@ pub fn remove_stale() {
             let dead = owner
                 .as_deref()
                 .and_then(|p| p.trim().parse::<u32>().ok())
-                .is_some_and(|pid| !Path::new(&format!("/proc/{pid}")).exists());
+                .is_some_and(|pid| !attsync_sched::process::exists(pid));
             if dead {
                 let _ = fs::remove_dir_all(e.path());
             }
@@ -185,7 +185,7 @@ pub fn remove_stale() {
         let run = name;
         let alive = owner
             .and_then(|p| p.trim().parse::<u32>().ok())
-            .is_some_and(|pid| Path::new(&format!("/proc/{pid}")).exists());
+            .is_some_and(attsync_sched::process::exists);
         if !alive {
             tracing_free_log(&format!("removing stale iceoryx2 namespace of run {run}"));
             remove(&run);

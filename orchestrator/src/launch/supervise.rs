@@ -316,30 +316,8 @@ pub fn kill_group(pgid: Option<u32>) {
     }
 }
 
-/// Processes of process group `pgid` still alive (read from /proc).
-#[must_use]
-pub fn group_members(pgid: u32) -> Vec<u32> {
-    let Ok(dir) = std::fs::read_dir("/proc") else {
-        return Vec::new();
-    };
-    dir.filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
-        .filter(|pid| {
-            std::fs::read_to_string(format!("/proc/{pid}/stat"))
-                .ok()
-                .and_then(|s| {
-                    // Fields after the command name (which may hold spaces): state ppid pgrp …
-                    let rest = &s[s.rfind(')')? + 2..];
-                    let mut f = rest.split_whitespace();
-                    let state = f.next()?;
-                    let pgrp = f.nth(1)?.parse::<u32>().ok()?;
-                    Some(pgrp == pgid && state != "Z")
-                })
-                .unwrap_or(false)
-        })
-        .collect()
-}
-
 pub use super::node_log::tail;
+pub use attsync_sched::process::group_members;
 
 /// Paths of the node binaries, found beside the running executable (or in
 /// `ATTSYNC_BIN_DIR`).

@@ -14,7 +14,6 @@
 
 use attitude::network::Network;
 use msgs::config::WaitStrategy;
-use std::os::unix::fs::MetadataExt;
 use std::path::Path;
 use thiserror::Error;
 
@@ -304,77 +303,25 @@ impl Host {
     /// are created. What cannot be read is `None` (not checked).
     #[must_use]
     pub fn read(root: &Path) -> Self {
-        let limits = std::fs::read_to_string("/proc/self/limits").unwrap_or_default();
-        // The owner of /proc/self is our (effective) uid; root has no RLIMIT_NPROC.
-        let uid = std::fs::metadata("/proc/self").map_or(0, |m| m.uid());
-        let max_user_tasks = soft_limit(&limits, "Max processes").filter(|_| uid != 0);
-        let (tasks, user_tasks) = count_tasks(uid, max_user_tasks.is_some());
+        use attsync_sched::{limits, machine};
+        // Root has no RLIMIT_NPROC.
+        let uid = limits::effective_uid();
+        let max_user_tasks = limits::soft_limit("Max processes").filter(|_| uid != 0);
+        let user_tasks = max_user_tasks.map_or(0, |_| limits::user_threads(uid));
         Self {
             max_user_tasks,
             user_tasks,
-            pid_max: read_number("/proc/sys/kernel/pid_max"),
-            threads_max: read_number("/proc/sys/kernel/threads-max"),
-            tasks,
-            max_open_files: soft_limit(&limits, "Max open files"),
-            open_files: std::fs::read_dir("/proc/self/fd").map_or(0, |d| d.count() as u64),
-            shm_free: free_space(Path::new("/dev/shm")),
-            root_free: free_space(root),
-            mem_available: mem_available(),
+            pid_max: limits::pid_max(),
+            threads_max: limits::threads_max(),
+            tasks: machine::tasks().unwrap_or(0),
+            max_open_files: limits::soft_limit("Max open files"),
+            open_files: limits::open_files(),
+            shm_free: limits::free_space(Path::new("/dev/shm")),
+            root_free: limits::free_space(root),
+            mem_available: machine::mem_available(),
             cores: std::thread::available_parallelism().map_or(1, |n| n.get() as u64),
         }
     }
-}
-
-/// The soft limit on the line `name` of `/proc/self/limits` (`None`: unlimited).
-fn soft_limit(limits: &str, name: &str) -> Option<u64> {
-    let line = limits.lines().find(|l| l.starts_with(name))?;
-    line[name.len()..].split_whitespace().next()?.parse().ok()
-}
-
-fn read_number(path: &str) -> Option<u64> {
-    std::fs::read_to_string(path).ok()?.trim().parse().ok()
-}
-
-/// Tasks on the machine (from `/proc/loadavg`), and, if `per_user`, the
-/// threads of processes whose real uid is `uid`.
-fn count_tasks(uid: u32, per_user: bool) -> (u64, u64) {
-    let loadavg = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-    let tasks = (loadavg.split_whitespace().nth(3))
-        .and_then(|f| f.split('/').nth(1)?.parse().ok())
-        .unwrap_or(0);
-    if !per_user {
-        return (tasks, 0);
-    }
-    let Ok(dir) = std::fs::read_dir("/proc") else {
-        return (tasks, 0);
-    };
-    let mine = dir
-        .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
-        .filter_map(|pid| std::fs::read_to_string(format!("/proc/{pid}/status")).ok())
-        .filter_map(|s| {
-            let field = |k: &str| {
-                s.lines()
-                    .find(|l| l.starts_with(k))
-                    .map(|l| l[k.len()..].to_owned())
-            };
-            let real_uid: u32 = field("Uid:")?.split_whitespace().next()?.parse().ok()?;
-            let threads: u64 = field("Threads:")?.trim().parse().ok()?;
-            (real_uid == uid).then_some(threads)
-        })
-        .sum();
-    (tasks, mine)
-}
-
-fn free_space(path: &Path) -> Option<u64> {
-    let s = nix::sys::statvfs::statvfs(path).ok()?;
-    Some(s.blocks_available() as u64 * s.fragment_size() as u64)
-}
-
-fn mem_available() -> Option<u64> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
 }
 
 #[cfg(test)]

@@ -1,72 +1,33 @@
-//! The machine's CPU load as [`super::placement`] needs it: busy time per
-//! core (`/proc/stat`) and the CPU time of the run's own processes
-//! (`/proc/<pid>/stat`), in clock ticks, turned into a
-//! [`Window`] per sampling period.
+//! The machine's CPU load as [`super::placement`] needs it: the busy time
+//! of each core ([`attsync_sched::busy`], the workspace's one definition)
+//! and the CPU time of the run's own processes ([`attsync_sched::schedstat`]:
+//! exact, where `/proc`'s per-process times are cut to clock ticks), turned
+//! into a [`Window`] per sampling period.
 
 use super::placement::{
     Cores, FIRST_WINDOW, HYSTERESIS, Placed, Placement, State, WINDOW, Window, decide, least_busy,
     place,
 };
+use attsync_sched::busy::Span;
+use attsync_sched::schedstat::on_cpu_ns;
+use attsync_sched::times::{CpuTimes, TICK};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Busy and total ticks of each core, by core number.
-fn per_core_ticks() -> Vec<(usize, u64, u64)> {
-    let Ok(stat) = std::fs::read_to_string("/proc/stat") else {
-        return Vec::new();
-    };
-    stat.lines()
-        .filter_map(|l| {
-            let rest = l.strip_prefix("cpu")?;
-            let (num, fields) = rest.split_once(' ')?;
-            let core = num.parse().ok()?;
-            let v: Vec<u64> = fields
-                .split_whitespace()
-                .filter_map(|x| x.parse().ok())
-                .collect();
-            // user nice system idle iowait irq softirq steal …: busy is
-            // what ran in this VM (steal — the hypervisor running someone
-            // else's VM — is not a competitor we could avoid by packing).
-            let at = |i: usize| v.get(i).copied().unwrap_or(0);
-            let busy = at(0) + at(1) + at(2) + at(5) + at(6);
-            let total: u64 = v.iter().take(8).sum();
-            Some((core, busy, total))
-        })
-        .collect()
-}
+/// Nanoseconds per clock tick of the cores' times.
+const NS_PER_TICK: u64 = TICK.as_nanos() as u64;
 
-/// Time `task` spent on a CPU, ns (`/proc/.../schedstat`: exact, where
-/// `/proc/<pid>/stat`'s utime and stime are cut to 10 ms ticks, an error of
-/// up to a tick per process per sample).
-fn task_ns(task: &std::path::Path) -> u64 {
-    std::fs::read_to_string(task.join("schedstat"))
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse().ok())
-        .unwrap_or(0)
-}
-
-/// CPU time of every thread of process `pid` (`self` for this one), ns.
-fn process_ns(pid: &str) -> u64 {
-    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
-        return 0;
-    };
-    tasks.flatten().map(|t| task_ns(&t.path())).sum()
-}
-
-/// Nanoseconds per tick of `/proc/stat` (`USER_HZ`, 100 on Linux).
-const NS_PER_TICK: u64 = 10_000_000;
-
-/// One sample: per-core (busy, total) ticks and the run's own CPU time, ns.
+/// One sample: each allowed core's times and the run's own CPU time, ns.
 struct Sample {
-    cores: Vec<(usize, u64, u64)>,
+    cores: Vec<(usize, CpuTimes)>,
     own: u64,
 }
 
 fn sample(pids: &[u32], allowed: &[usize]) -> Sample {
-    let cores = per_core_ticks()
-        .into_iter()
-        .filter(|(c, _, _)| allowed.contains(c))
+    let times = attsync_sched::times::read_now().unwrap_or_default();
+    let cores = (times.cores.into_iter())
+        .filter(|(c, _)| allowed.contains(c))
         .collect();
-    let own = pids.iter().map(|p| process_ns(&p.to_string())).sum::<u64>() + process_ns("self");
+    let own = pids.iter().map(|&p| on_cpu_ns(p)).sum::<u64>() + on_cpu_ns(std::process::id());
     Sample { cores, own }
 }
 
@@ -75,11 +36,11 @@ fn window(a: &Sample, b: &Sample) -> Window {
     let mut busy = 0u64;
     let mut span = 0u64;
     let mut per_core = Vec::new();
-    for (&(core, b0, t0), &(_, b1, t1)) in a.cores.iter().zip(&b.cores) {
-        let (db, dt) = (b1.saturating_sub(b0), t1.saturating_sub(t0));
-        busy += db;
-        span = span.max(dt);
-        per_core.push((core, if dt == 0 { 0.0 } else { db as f64 / dt as f64 }));
+    for ((core, t0), (_, t1)) in a.cores.iter().zip(&b.cores) {
+        let s = Span::between(t0, t1);
+        busy += s.busy;
+        span = span.max(s.total);
+        per_core.push((*core, s.fraction()));
     }
     let foreign = (busy * NS_PER_TICK).saturating_sub(b.own.saturating_sub(a.own));
     Window {

@@ -16,13 +16,13 @@
 //! and spreads again once it falls below [`QUIET`]. The placement never
 //! changes what a node computes: lockstep results stay byte-identical.
 //!
-//! The [`Placer`] thread samples `/proc/stat` and each node's
-//! `/proc/<pid>/stat` every [`WINDOW`]; [`decide`] is the policy, pure.
+//! The [`Placer`] thread samples the busy time of every core and the CPU
+//! time of each node ([`attsync_sched::busy`], [`attsync_sched::schedstat`])
+//! every [`WINDOW`]; [`decide`] is the policy, pure.
 
 use super::partition::{cut_edges, partition};
+use attsync_sched::{affinity, process, timeslice::SHORT_SLICE};
 use msgs::config::Contention;
-use nix::sched::{CpuSet, sched_getaffinity, sched_setaffinity};
-use nix::unistd::Pid;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -117,25 +117,15 @@ pub fn least_busy(w: &Window) -> Option<usize> {
         .map(|&(core, _)| core)
 }
 
-/// Moves every thread of `pid` onto `set` with time slices of `slice`
+/// Moves every thread of `pid` onto `cores` with time slices of `slice`
 /// (`None`: the kernel's default); threads started later inherit both.
-fn apply(pid: u32, set: &CpuSet, slice: Option<Duration>) {
-    let tasks = std::fs::read_dir(format!("/proc/{pid}/task"));
-    for t in tasks.into_iter().flatten().flatten() {
-        if let Some(tid) = t.file_name().to_str().and_then(|s| s.parse().ok()) {
-            let _ = sched_setaffinity(Pid::from_raw(tid), set);
-            if let Err(e) = attsync_sched::set_slice(tid, slice) {
-                tracing::debug!(pid, tid, "time slice unchanged: {e}");
-            }
+fn apply(pid: u32, cores: &[usize], slice: Option<Duration>) {
+    for tid in process::threads(pid) {
+        let _ = affinity::set(tid, cores);
+        if let Err(e) = attsync_sched::timeslice::set_slice(tid, slice) {
+            tracing::debug!(pid, tid, "time slice unchanged: {e}");
         }
     }
-}
-
-/// The cores of `set`.
-fn cores_of(set: &CpuSet) -> Vec<usize> {
-    (0..CpuSet::count())
-        .filter(|&c| set.is_set(c).unwrap_or(false))
-        .collect()
 }
 
 /// Whether a [`Placer`] for `placement` watches the load with `cores`
@@ -149,7 +139,7 @@ fn watches(placement: Placement, cores: usize) -> bool {
 /// else the nodes' waiters. Goes into every node's configuration.
 #[must_use]
 pub fn contention(placement: Placement) -> Contention {
-    let cores = sched_getaffinity(Pid::from_raw(0)).map_or(1, |set| cores_of(&set).len());
+    let cores = affinity::of(0).map_or(1, |list| list.len());
     if watches(placement, cores) {
         Contention::Placement
     } else {
@@ -167,9 +157,7 @@ pub struct Placer {
 /// The cores a run may use, and where each of its nodes goes while spread.
 #[derive(Debug, Clone)]
 pub(super) struct Cores {
-    /// Every core the orchestrator may use.
-    pub allowed: CpuSet,
-    /// Their numbers.
+    /// Every core the orchestrator may use, ascending.
     pub list: Vec<usize>,
     /// Per node (in `pids` order) its core while spread; empty: any allowed core.
     pub pinned: Vec<usize>,
@@ -179,8 +167,7 @@ impl Cores {
     /// For `placement` of nodes whose graph is `adjacency` (one entry per
     /// node, in `pids` order): pinned by [`partition`] under `Pin`, and
     /// under `Auto` when the nodes outnumber the cores.
-    fn of(placement: Placement, allowed: CpuSet, adjacency: &[Vec<usize>]) -> Self {
-        let list = cores_of(&allowed);
+    fn of(placement: Placement, list: Vec<usize>, adjacency: &[Vec<usize>]) -> Self {
         let pin = match placement {
             Placement::Auto => adjacency.len() > list.len(),
             Placement::Pin => true,
@@ -198,11 +185,7 @@ impl Cores {
         } else {
             Vec::new()
         };
-        Self {
-            allowed,
-            list,
-            pinned,
-        }
+        Self { list, pinned }
     }
 }
 
@@ -212,7 +195,7 @@ impl Placer {
     #[must_use]
     pub fn start(placement: Placement, pids: Vec<u32>, adjacency: &[Vec<usize>]) -> Self {
         let stop = Arc::new(AtomicBool::new(false));
-        let Ok(allowed) = sched_getaffinity(Pid::from_raw(0)) else {
+        let Ok(allowed) = affinity::of(0) else {
             return Self { stop, thread: None };
         };
         let cores = Cores::of(placement, allowed, adjacency);
@@ -240,7 +223,7 @@ impl Drop for Placer {
 /// (`adjacency[k]`: the positions in `pids` of node `k`'s neighbours); for
 /// the benchmark's bare lockstep, placed like a run.
 pub fn pin(pids: &[u32], adjacency: &[Vec<usize>]) {
-    if let Ok(allowed) = sched_getaffinity(Pid::from_raw(0)) {
+    if let Ok(allowed) = affinity::of(0) {
         let cores = Cores::of(Placement::Pin, allowed, adjacency);
         if !cores.pinned.is_empty() {
             place(pids, Placed::Spread, &cores);
@@ -253,33 +236,24 @@ pub fn pin(pids: &[u32], adjacency: &[Vec<usize>]) {
 pub(super) fn place(pids: &[u32], placed: Placed, cores: &Cores) {
     for (k, &pid) in pids.iter().enumerate() {
         let set = match (placed, cores.pinned.get(k)) {
-            (Placed::Spread, None) => Some(cores.allowed),
-            (Placed::Spread, Some(&core)) | (Placed::Packed(core), _) => only(core),
+            (Placed::Spread, None) => cores.list.clone(),
+            (Placed::Spread, Some(&core)) | (Placed::Packed(core), _) => vec![core],
         };
-        if let Some(set) = set {
-            apply(pid, &set, slice(placed));
-        }
+        apply(pid, &set, slice(placed));
     }
 }
 
 /// The time slice of a node placed as `placed`: packed onto a core that a
 /// competitor may share, the shortest the kernel grants
-/// ([`attsync_sched::SHORT_SLICE`]), so that a node whose input has come
+/// ([`SHORT_SLICE`]), so that a node whose input has come
 /// runs within microseconds instead of after the competitor's slice, and a
 /// yield hands the competitor a fourteenth of what it did (docs/waiting.md,
 /// "Short slices"); spread, the kernel's default.
 fn slice(placed: Placed) -> Option<Duration> {
     match placed {
-        Placed::Packed(_) => Some(attsync_sched::SHORT_SLICE),
+        Placed::Packed(_) => Some(SHORT_SLICE),
         Placed::Spread => None,
     }
-}
-
-/// The set of core `core` alone.
-fn only(core: usize) -> Option<CpuSet> {
-    let mut one = CpuSet::new();
-    one.set(core).ok()?;
-    Some(one)
 }
 
 #[cfg(test)]
@@ -344,14 +318,13 @@ mod tests {
 
     /// The CPUs process `pid` may run on, and its slice.
     fn placed(pid: u32) -> (Vec<usize>, Option<Duration>) {
-        let tid = i32::try_from(pid).expect("pid");
-        let set = sched_getaffinity(Pid::from_raw(tid)).expect("affinity");
-        (cores_of(&set), attsync_sched::slice_of(tid).expect("slice"))
+        let slice = attsync_sched::timeslice::slice_of(pid).expect("slice");
+        (affinity::of(pid).expect("affinity"), slice)
     }
 
     #[test]
     fn packed_a_node_gets_one_core_and_short_slices_spread_every_core_and_the_default_again() {
-        let allowed = sched_getaffinity(Pid::from_raw(0)).expect("affinity");
+        let allowed = affinity::of(0).expect("affinity");
         let cores = Cores::of(Placement::Auto, allowed, &[Vec::new()]);
         let mut node = std::process::Command::new("sleep")
             .arg("30")
@@ -365,8 +338,8 @@ mod tests {
         let spread = placed(pid);
         let _ = node.kill();
         let _ = node.wait();
-        let short = if attsync_sched::custom_slices() {
-            Some(attsync_sched::SHORT_SLICE)
+        let short = if attsync_sched::timeslice::custom_slices() {
+            Some(SHORT_SLICE)
         } else {
             default
         };
@@ -374,11 +347,8 @@ mod tests {
         assert_eq!(spread, (all, default));
     }
 
-    fn two_cores() -> CpuSet {
-        let mut set = CpuSet::new();
-        set.set(3).unwrap();
-        set.set(5).unwrap();
-        set
+    fn two_cores() -> Vec<usize> {
+        vec![3, 5]
     }
 
     #[test]
@@ -407,8 +377,7 @@ mod tests {
             );
         }
         // One core: nothing to choose.
-        let mut one = CpuSet::new();
-        one.set(0).unwrap();
+        let one = vec![0];
         assert!(Cores::of(Placement::Pin, one, &path(6)).pinned.is_empty());
     }
 }

@@ -3,7 +3,6 @@
 //! be read is `unknown`: it describes the run, it never stops it.
 
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// What is written for a value that cannot be read.
 pub const UNKNOWN: &str = "unknown";
@@ -15,7 +14,7 @@ pub struct Platform {
     pub os: String,
     /// CPU architecture (`std::env::consts::ARCH`: `x86_64`, `aarch64`, …).
     pub arch: String,
-    /// The CPU model from `/proc/cpuinfo`, or `unknown`.
+    /// The CPU model ([`attsync_sched::machine::cpu_model`]), or `unknown`.
     pub cpu_model: String,
     /// Cores this process may run on (its affinity mask; 0 if unknown).
     pub cores: usize,
@@ -27,33 +26,15 @@ impl Platform {
     /// This machine.
     #[must_use]
     pub fn read() -> Self {
-        let text = |p: &str| std::fs::read_to_string(Path::new(p)).ok();
+        use attsync_sched::machine;
         Self {
             os: std::env::consts::OS.into(),
             arch: std::env::consts::ARCH.into(),
-            cpu_model: text("/proc/cpuinfo")
-                .and_then(|t| cpu_model(&t))
-                .unwrap_or_else(|| UNKNOWN.into()),
+            cpu_model: machine::cpu_model().unwrap_or_else(|| UNKNOWN.into()),
             cores: std::thread::available_parallelism().map_or(0, std::num::NonZero::get),
-            kernel: text("/proc/sys/kernel/osrelease")
-                .map(|k| k.trim().to_owned())
-                .filter(|k| !k.is_empty())
-                .unwrap_or_else(|| UNKNOWN.into()),
+            kernel: machine::kernel_release().unwrap_or_else(|| UNKNOWN.into()),
         }
     }
-}
-
-/// The CPU model in the text of `/proc/cpuinfo`: the first `model name`
-/// (x86), else `Hardware`, `cpu model` or `uarch` (ARM, MIPS, RISC-V).
-fn cpu_model(cpuinfo: &str) -> Option<String> {
-    ["model name", "Hardware", "cpu model", "uarch"]
-        .iter()
-        .find_map(|key| {
-            cpuinfo.lines().find_map(|line| {
-                let (k, v) = line.split_once(':')?;
-                (k.trim() == *key && !v.trim().is_empty()).then(|| v.trim().to_owned())
-            })
-        })
 }
 
 #[cfg(test)]
@@ -61,19 +42,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_cpu_model_is_the_first_model_name() {
-        let x86 = "processor\t: 0\nvendor_id\t: GenuineIntel\nmodel\t\t: 85\n\
-                   model name\t: Intel(R) Xeon(R) CPU @ 2.00GHz\nprocessor\t: 1\n\
-                   model name\t: Intel(R) Xeon(R) CPU @ 2.00GHz\n";
-        assert_eq!(
-            cpu_model(x86).as_deref(),
-            Some("Intel(R) Xeon(R) CPU @ 2.00GHz")
-        );
-        assert_eq!(
-            cpu_model("processor : 0\nHardware : BCM2835\n").as_deref(),
-            Some("BCM2835")
-        );
-        assert_eq!(cpu_model("processor : 0\nmodel : 85\n"), None);
+    fn the_platform_is_read() {
         let p = Platform::read();
         assert_eq!(
             (p.os.as_str(), p.arch.as_str()),

@@ -241,7 +241,7 @@ fn remove_dead_staging(parent: &Path, name: &str) {
         let Some(pid) = layout::staging_pid(name, &entry) else {
             continue;
         };
-        if !Path::new(&format!("/proc/{pid}")).exists() {
+        if !attsync_sched::process::exists(pid) {
             let _ = fs::remove_dir_all(e.path());
         }
     }
