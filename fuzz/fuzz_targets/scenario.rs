@@ -4,7 +4,7 @@
 //! --set` would. Then `attsync check`'s report of a scenario that loads.
 #![no_main]
 
-use attsync::options::StiffnessCheck;
+use attsync::scenario::StiffnessCheck;
 use attsync::scenario::{self, report};
 // Its allocator: a request over MAX_ALLOCATION is a crash.
 use attsync_fuzz as _;
