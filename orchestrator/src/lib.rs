@@ -41,7 +41,7 @@ pub mod failure;
 pub mod generate;
 pub mod hosts;
 pub mod interrupt;
-pub mod launch;
+pub use ::launch;
 pub mod margin;
 pub mod mc;
 pub mod options;
