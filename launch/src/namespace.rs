@@ -199,6 +199,12 @@ fn tracing_free_log(msg: &str) {
     }
 }
 
+/// `node-<id>.json`, node `id`'s configuration in its run's namespace directory.
+#[must_use]
+pub fn node_config_file(id: u32) -> String {
+    format!("node-{id}.json")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

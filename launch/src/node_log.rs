@@ -141,6 +141,12 @@ pub fn cut_note(host: &str, cut: u64) -> String {
     )
 }
 
+/// `<name>.log`, the log of node `name` (`leader`, `agent-3`).
+#[must_use]
+pub fn node_log_file(name: &str) -> String {
+    format!("{name}.log")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -99,8 +99,8 @@ impl Error {
             Error::Verify(e) => e.exit_code(),
             Error::Sweep(e) => e.exit_code(),
             Error::Mc(e) => e.exit_code(),
-            Error::Host(e) => e.exit_code(),
-            Error::Trust(e) => e.exit_code(),
+            Error::Host(e) => crate::exit::invalid_if(e.is_invalid()),
+            Error::Trust(e) => crate::exit::invalid_if(e.is_invalid()),
             _ => crate::exit::FAILED,
         }
     }

@@ -27,3 +27,9 @@ pub const DIVERGED: u8 = 3;
 pub fn interrupted(signal: i32) -> u8 {
     u8::try_from(128 + signal).unwrap_or(u8::MAX)
 }
+
+/// [`INVALID`] if the user's input is at fault, else [`FAILED`].
+#[must_use]
+pub fn invalid_if(invalid: bool) -> u8 {
+    if invalid { INVALID } else { FAILED }
+}

@@ -13,16 +13,15 @@
 //! - [`until`]: `--tolerance` and `--until settled`: what a run is judged by
 //!   (its verdict, `attsync_verdict`) and how long it goes.
 //! - [`generate`]: generated scenarios (random trees).
-//! - [`hosts`]: placement files (`--hosts HOSTS.toml`): which machine runs
-//!   which node, and the cut edges between machines (issue 12).
+//! - [`hosts`], [`remote`], [`trust`] (the `attsync-bridge` crate): runs
+//!   across machines: placement files, the host daemon, the Zenoh bridges,
+//!   mutual TLS.
 //! - [`mc`]: the Monte Carlo over initial conditions (`attsync mc`).
 //! - [`margin`]: `attsync margin`, the linearisation's delay margin and rightmost root.
 //! - [`conform`]: the conformance check of a plug-in agent program.
 //! - [`verify`]: `attsync verify`, a run's files against its `manifest.json`
 //!   and a re-run of its scenario against its `states.bin` and `errors.csv`.
 //! - [`options`]: range checks of command-line options, before anything starts.
-//! - [`trust`]: who may talk to a daemon (mutual TLS or `--insecure`), the
-//!   plug-ins it may start, `--gen-certs`.
 //! - [`interrupt`]: SIGINT, SIGTERM and SIGHUP as one interrupt that names its signal.
 //! - [`error`]: [`enum@Error`], every way a command fails, and its exit code.
 //! - [`view`]: `view.html`, a run in 3D in the browser (one self-contained file).
@@ -39,7 +38,7 @@ pub mod exit;
 pub mod export;
 pub mod failure;
 pub mod generate;
-pub mod hosts;
+pub use ::bridge::hosts;
 pub mod interrupt;
 pub use ::launch;
 pub mod margin;
@@ -49,12 +48,13 @@ pub mod outcome;
 pub mod pool;
 pub mod processes;
 pub mod progress;
-pub mod remote;
+pub use ::bridge::remote;
+mod remote_site;
 pub mod results;
 pub mod run;
 pub use ::scenario;
 pub mod sweep;
-pub mod trust;
+pub use ::bridge::trust;
 pub mod until;
 pub mod verify;
 pub mod view;

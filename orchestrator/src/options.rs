@@ -19,13 +19,7 @@ use clap::ValueEnum;
 use msgs::config::WaitStrategy;
 use thiserror::Error;
 
-/// Longest duration an option may give, s (one day: a wait past it is a
-/// mistake, and `Duration::from_secs_f64` would overflow not far above).
-pub const MAX_SECONDS: f64 = 86_400.0;
-
-/// Largest real-time factor (simulated s per wall s): past it, a step of
-/// any sensible `dt` is due in less than a nanosecond.
-pub const MAX_REALTIME: f64 = 1e6;
+pub use launch::bounds::{MAX_REALTIME, MAX_SECONDS};
 
 /// Most bisection iterations (each halves the bracket: 64 reach f64's
 /// resolution of any bracket).
@@ -87,14 +81,7 @@ fn out_of_range(option: &'static str, value: impl ToString, expected: String) ->
 /// # Errors
 /// The value is outside that range.
 pub fn seconds(option: &'static str, value: f64) -> Result<(), OptionError> {
-    if value.is_finite() && value > 0.0 && value <= MAX_SECONDS {
-        return Ok(());
-    }
-    Err(out_of_range(
-        option,
-        value,
-        format!("must be a number of seconds > 0 and at most {MAX_SECONDS} (1 day)"),
-    ))
+    Ok(launch::bounds::seconds(option, value)?)
 }
 
 /// A real-time factor: finite, > 0, at most [`MAX_REALTIME`].
@@ -102,16 +89,17 @@ pub fn seconds(option: &'static str, value: f64) -> Result<(), OptionError> {
 /// # Errors
 /// The value is outside that range.
 pub fn realtime(value: f64) -> Result<(), OptionError> {
-    if value.is_finite() && value > 0.0 && value <= MAX_REALTIME {
-        return Ok(());
+    Ok(launch::bounds::realtime("--realtime", value)?)
+}
+
+impl From<launch::bounds::OutOfRange> for OptionError {
+    fn from(e: launch::bounds::OutOfRange) -> Self {
+        Self::OutOfRange {
+            option: e.setting,
+            value: e.value,
+            expected: e.expected,
+        }
     }
-    Err(out_of_range(
-        "--realtime",
-        value,
-        format!(
-            "the factor must be a positive number (simulated s per wall s) of at most {MAX_REALTIME}"
-        ),
-    ))
 }
 
 /// A positive finite number.

@@ -81,7 +81,7 @@ fn a_thirty_agent_tree_over_three_hosts_is_byte_identical() {
 /// 60 agents on one host: their configurations make a run request of
 /// ~86 KB (measured: `ATTSYNC_LOG=attsync=debug` logs it), more than the
 /// 64 KiB that Zenoh's low-latency transport carries in one message, so it
-/// travels in pieces (`orchestrator/src/remote/pieces.rs`); their end
+/// travels in pieces (`bridge/src/remote/pieces.rs`); their end
 /// reply (60 log tails) too.
 #[test]
 fn a_run_request_larger_than_a_zenoh_batch_arrives_whole() {

@@ -3,9 +3,7 @@
 //! (`summary.json` `incomplete_reason`, its [`Display`](std::fmt::Display)
 //! text) and to the exit code ([`Failure::exit_code`]).
 
-mod host;
-
-pub use host::RemoteError;
+pub use bridge::remote::RemoteError;
 use std::fmt;
 
 /// Why a run stopped early. Its text is `summary.json`'s `incomplete_reason`.

@@ -7,6 +7,7 @@
 use super::ProcessError;
 use crate::failure::Failure;
 use crate::scenario::plugin::Plugin;
+pub use launch::site_exit::SiteExit;
 use msgs::config::NodeConfig;
 use msgs::{ControlMsg, Limits};
 use std::fmt::Debug;
@@ -73,19 +74,4 @@ pub struct SetupNode<'a> {
     pub name: String,
     /// Its plug-in command, if a plug-in runs it.
     pub plugin: Option<&'a Plugin>,
-}
-
-/// A node's end on a site, as the site reported it.
-#[derive(Debug, Clone)]
-pub struct SiteExit {
-    /// The node's id.
-    pub id: u32,
-    /// The machine it ran on.
-    pub host: String,
-    /// Its exit, described.
-    pub status: String,
-    /// It exited with code 0.
-    pub clean: bool,
-    /// The last lines of its log.
-    pub tail: String,
 }

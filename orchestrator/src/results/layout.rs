@@ -103,17 +103,8 @@ pub fn node_name(id: u32) -> String {
     }
 }
 
-/// `<name>.log`, the log of node `name` (see [`node_name`]).
-#[must_use]
-pub fn node_log_file(name: &str) -> String {
-    format!("{name}.log")
-}
-
-/// `node-<id>.json`, node `id`'s configuration in its run's namespace directory.
-#[must_use]
-pub fn node_config_file(id: u32) -> String {
-    format!("node-{id}.json")
-}
+pub use launch::namespace::node_config_file;
+pub use launch::node_log::node_log_file;
 
 /// `.<name>.partial-<pid>`: the staging directory of `<name>` written by process `pid`.
 #[must_use]

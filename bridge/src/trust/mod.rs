@@ -111,14 +111,11 @@ pub enum TrustError {
 }
 
 impl TrustError {
-    /// 2 for a bad flag or file (nothing started), 1 if certificates could
-    /// not be made.
+    /// A bad flag or file: the user's input is at fault, nothing started
+    /// (exit code 2); not so if certificates could not be made.
     #[must_use]
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            Self::Certs(_) => crate::exit::FAILED,
-            _ => crate::exit::INVALID,
-        }
+    pub fn is_invalid(&self) -> bool {
+        !matches!(self, Self::Certs(_))
     }
 }
 

@@ -4,8 +4,8 @@
 
 use super::file::HostsFile;
 use super::{Hosts, HostsError};
-use crate::scenario::Issue;
 use crate::trust::{FieldNames, Security, TlsFiles};
+use scenario::Issue;
 use std::path::Path;
 
 /// The `[tls]` table's field names, for messages.

@@ -1,8 +1,8 @@
 //! Why a host refuses a run request ([`RequestError`]) or cannot start the
 //! nodes of one it admitted ([`StartError`]); the orchestrator gets the text.
 
-use crate::launch::supervise::MissingBinaries;
 use crate::trust::allow::AdmitError;
+use launch::supervise::MissingBinaries;
 use msgs::iox::IoxError;
 use msgs::open::OpenError;
 use std::path::PathBuf;

@@ -20,6 +20,7 @@
 pub mod bridge;
 mod bridge_error;
 pub mod client;
+mod client_error;
 pub mod daemon;
 pub mod host_run;
 mod host_run_error;
@@ -28,13 +29,12 @@ pub mod link;
 pub mod local;
 pub mod pieces;
 pub mod plan;
-mod site;
 pub mod telemetry;
 pub mod wire;
 pub mod zconfig;
 
-pub use crate::failure::RemoteError;
 pub use client::Remote;
+pub use client_error::RemoteError;
 pub use plan::{Plan, PlannedHost};
 
 use serde::{Deserialize, Serialize};

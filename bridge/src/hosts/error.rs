@@ -1,9 +1,9 @@
 //! [`HostsError`]: why a hosts file could not be loaded or placed, every
 //! problem of a stage at once, one line each as `FILE: FIELD: REASON` (as a
-//! scenario's, [`crate::scenario::ScenarioError`]).
+//! scenario's, [`scenario::ScenarioError`]).
 
-use crate::scenario::input::ReadError;
-use crate::scenario::{Issue, fmt_issues};
+use scenario::input::ReadError;
+use scenario::{Issue, fmt_issues};
 use std::path::PathBuf;
 use thiserror::Error;
 

@@ -5,6 +5,7 @@
 //! and `Stop` relayed, each host's node exits and failures as they happen,
 //! and at the end every host's exits and logs.
 
+use super::RemoteError;
 use super::Side;
 use super::bridge::Bridges;
 use super::keys;
@@ -13,15 +14,14 @@ use super::pieces;
 use super::plan::{Plan, links};
 use super::telemetry::{self, End, TelemetryThread};
 use super::wire::{
-    Answer, EndReply, EndRequest, HostEvent, NodeEnd, PluginCommand, RemoteNode, RunOffer,
-    RunRequest,
+    Answer, EndReply, EndRequest, HostEvent, NodeEnd, RemoteNode, RunOffer, RunRequest,
 };
 use super::zconfig;
-pub use crate::failure::RemoteError;
-use crate::launch::node_log::cut_note;
-use crate::processes::site::{Setup, SiteExit};
+use launch::node_log::cut_note;
+use launch::site_exit::SiteExit;
 use msgs::ControlMsg;
 use msgs::bytes::Bytes;
+use msgs::config::NodeConfig;
 use std::io::Write;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -159,17 +159,11 @@ impl Remote {
         }
     }
 
-    /// Starts the local bridges and telemetry sinks in the run's namespace,
-    /// then hands each host its nodes.
-    pub fn start(&mut self, setup: &Setup<'_>) -> Result<(), RemoteError> {
-        let ns = &LocalNs {
-            run: setup.run.to_string(),
-            dir: setup.dir.to_owned(),
-            limits: setup.limits,
-            stage_timeout: setup.stage_timeout,
-            realtime: setup.realtime,
-        };
-        let links = links(setup.configs, &self.plan);
+    /// Starts the local bridges and telemetry sinks in namespace `ns`,
+    /// then hands each host its nodes (of `nodes`, every node of the run).
+    pub fn start(&mut self, ns: &LocalNs, nodes: &[RemoteNode]) -> Result<(), RemoteError> {
+        let configs: Vec<NodeConfig> = nodes.iter().map(|n| n.config.clone()).collect();
+        let links = links(&configs, &self.plan);
         let (s, run) = (&self.session, self.run.as_str());
         self.bridges = Some(Bridges::start(
             s,
@@ -190,13 +184,9 @@ impl Remote {
             let req = RunRequest {
                 run: self.run.clone(),
                 host: h.name.clone(),
-                nodes: (setup.configs.iter().zip(&setup.nodes))
-                    .filter(|(c, _)| h.nodes.contains(&c.id))
-                    .map(|(c, n)| RemoteNode {
-                        name: n.name.clone(),
-                        config: c.clone(),
-                        plugin: n.plugin.map(PluginCommand::of),
-                    })
+                nodes: (nodes.iter())
+                    .filter(|n| h.nodes.contains(&n.config.id))
+                    .cloned()
                     .collect(),
                 links: (links.iter())
                     .filter(|l| l.from_side == me || l.to_side == me)
@@ -339,7 +329,7 @@ impl Remote {
                 continue;
             };
             for n in reply.nodes {
-                let file = logs.join(crate::results::layout::node_log_file(&node_name(n.id)));
+                let file = logs.join(launch::node_log::node_log_file(&node_name(n.id)));
                 let _ = write_log(&file, &name, &n);
                 if !n.clean {
                     bad.push(SiteExit {

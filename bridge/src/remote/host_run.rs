@@ -13,11 +13,11 @@ use super::local::{LocalNs, Shared};
 use super::pieces;
 use super::telemetry::{self, End, TelemetryThread};
 use super::wire::{Answer, EndReply, EndRequest, HostEvent, NodeEnd, RunOffer, RunRequest};
-use crate::launch::namespace::Namespace;
-use crate::launch::node_log::last_bytes;
-use crate::launch::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
 use crate::trust::allow::{Allowlist, Asked};
 use iceoryx2::prelude::*;
+use launch::namespace::Namespace;
+use launch::node_log::last_bytes;
+use launch::supervise::{Exit, Launch, Supervisor, describe, find_binaries, tail};
 use msgs::bytes::Bytes;
 use msgs::config::Contention;
 use msgs::iox::iox;
@@ -101,12 +101,10 @@ fn start(
         c.run.clone_from(&local.run);
         c.iox_root = local.dir.to_string_lossy().into_owned();
         c.contention = Contention::Waiter; // no placer watches this machine
-        let file = local
-            .dir
-            .join(crate::results::layout::node_config_file(c.id));
+        let file = local.dir.join(launch::namespace::node_config_file(c.id));
         c.write(&file)
             .map_err(|e| io_at(&file)(std::io::Error::other(e)))?;
-        let log = logs.join(crate::results::layout::node_log_file(&n.name));
+        let log = logs.join(launch::node_log::node_log_file(&n.name));
         let launch = match &n.plugin {
             Some(p) => Launch::Plugin {
                 command: &p.command,
@@ -227,10 +225,10 @@ fn check_node(n: &super::wire::RemoteNode) -> Result<(), RequestError> {
         return Err(bad(&"its name is not letters, digits, `-`, `_`"));
     }
     let c = &n.config;
-    crate::options::seconds("stage_timeout", c.stage_timeout).map_err(|e| bad(&e))?;
-    crate::options::seconds("start_timeout", c.start_timeout).map_err(|e| bad(&e))?;
+    launch::bounds::seconds("stage_timeout", c.stage_timeout).map_err(|e| bad(&e))?;
+    launch::bounds::seconds("start_timeout", c.start_timeout).map_err(|e| bad(&e))?;
     match c.realtime {
-        Some(f) => crate::options::realtime(f).map_err(|e| bad(&e)),
+        Some(f) => launch::bounds::realtime("realtime", f).map_err(|e| bad(&e)),
         None => Ok(()),
     }
 }

@@ -4,7 +4,7 @@
 //! agent 0, the leader's node id), no host with nothing on it.
 
 use super::endpoint;
-use crate::scenario::Issue;
+use scenario::Issue;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;

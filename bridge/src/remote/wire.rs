@@ -34,7 +34,7 @@ pub struct PluginCommand {
 impl PluginCommand {
     /// The command of plug-in `p`, as a host starts it.
     #[must_use]
-    pub fn of(p: &crate::scenario::plugin::Plugin) -> Self {
+    pub fn of(p: &scenario::plugin::Plugin) -> Self {
         Self {
             command: p.command.clone(),
             env: p.env.clone(),
@@ -111,7 +111,7 @@ pub struct NodeEnd {
     /// It exited with code 0.
     pub clean: bool,
     /// The end of its log (stdout and stderr, capped as in a local run):
-    /// at most its last [`crate::launch::node_log::TAIL_BYTES`], from a
+    /// at most its last [`launch::node_log::TAIL_BYTES`], from a
     /// line's start, so that a host's reply stays bounded.
     pub log: Vec<u8>,
     /// How many bytes of its log before [`Self::log`] stayed on the host.

@@ -9,8 +9,8 @@
 //! edge both ways (`A_{i,j} = A_{j,i}`).
 
 use super::{Host, Hosts, HostsError};
-use crate::scenario::Issue;
 use attitude::network::Network;
+use scenario::Issue;
 use std::collections::HashMap;
 
 /// The leader's node id.
@@ -177,7 +177,7 @@ mod tests {
     const PAPER: &str = include_str!("../../../scenarios/paper/timevarying.toml");
 
     fn paper() -> Network {
-        let loaded = crate::scenario::load_str(Path::new("paper.toml"), PAPER, &[]);
+        let loaded = scenario::load_str(Path::new("paper.toml"), PAPER, &[]);
         loaded.unwrap_or_else(|e| panic!("{e}")).resolved.network
     }
 

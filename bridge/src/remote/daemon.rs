@@ -51,13 +51,13 @@ pub enum HostError {
 }
 
 impl HostError {
-    /// 2 for a bad option, else 1.
+    /// A bad option or endpoint: the user's input is at fault (exit code 2).
     #[must_use]
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            Self::Invalid(_) | Self::Config(ConfigError::Endpoint { .. }) => crate::exit::INVALID,
-            _ => crate::exit::FAILED,
-        }
+    pub fn is_invalid(&self) -> bool {
+        matches!(
+            self,
+            Self::Invalid(_) | Self::Config(ConfigError::Endpoint { .. })
+        )
     }
 }
 

@@ -1,5 +1,5 @@
 //! [`RemoteError`]: why the orchestrator's side of a run placed over hosts
-//! ([`crate::remote::Remote`]) could not connect, start, relay or go on.
+//! ([`super::Remote`]) could not connect, start, relay or go on.
 
 use thiserror::Error;
 

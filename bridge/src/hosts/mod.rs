@@ -42,7 +42,7 @@ pub use error::HostsError;
 pub use file::Host;
 pub use placement::{CutEdge, Placement};
 
-use crate::scenario::input::{self, Limit};
+use scenario::input::{self, Limit};
 use std::path::{Path, PathBuf};
 
 /// The largest hosts file accepted: 64 MiB (room for millions of agent ids).
@@ -77,7 +77,7 @@ pub fn load(path: &Path) -> Result<Hosts, HostsError> {
 
 /// As [`load`], from text already read (`path` is used in messages).
 pub fn load_str(path: &Path, text: &str) -> Result<Hosts, HostsError> {
-    let parsed: file::HostsFile = crate::scenario::parse::typed(text)
+    let parsed: file::HostsFile = scenario::parse::typed(text)
         .map_err(|issues| HostsError::Invalid(path.to_owned(), issues))?;
     let mut issues = file::check(&parsed.host);
     let security = security::of_file(path, &parsed, &mut issues);

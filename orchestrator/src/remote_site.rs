@@ -1,10 +1,13 @@
 //! A run across machines as the process engine sees it: a [`Plan`] opens
-//! a [`Remote`], which is the [`Site`] of every node placed on a host.
+//! a [`Remote`] (the `attsync-bridge` crate), which is the [`Site`] of
+//! every node placed on a host.
 
-use super::{Plan, Remote};
 use crate::failure::Failure;
 use crate::processes::ProcessError;
 use crate::processes::site::{Elsewhere, Setup, Site, SiteExit};
+use crate::remote::local::LocalNs;
+use crate::remote::wire::{PluginCommand, RemoteNode};
+use crate::remote::{Plan, Remote};
 use msgs::ControlMsg;
 use std::path::Path;
 
@@ -24,7 +27,21 @@ impl Site for Remote {
     }
 
     fn start(&mut self, setup: &Setup<'_>) -> Result<(), Failure> {
-        Ok(Remote::start(self, setup)?)
+        let ns = LocalNs {
+            run: setup.run.to_string(),
+            dir: setup.dir.to_owned(),
+            limits: setup.limits,
+            stage_timeout: setup.stage_timeout,
+            realtime: setup.realtime,
+        };
+        let nodes: Vec<RemoteNode> = (setup.configs.iter().zip(&setup.nodes))
+            .map(|(c, n)| RemoteNode {
+                name: n.name.clone(),
+                config: c.clone(),
+                plugin: n.plugin.map(PluginCommand::of),
+            })
+            .collect();
+        Ok(Remote::start(self, &ns, &nodes)?)
     }
 
     fn control(&self, msg: ControlMsg) -> Result<(), Failure> {
