@@ -126,6 +126,28 @@ pub fn apply<T: Tree>(doc: &mut T, spec: &str) -> Result<(), OverrideError> {
     set(doc, &segments, value)
 }
 
+/// The value at `path` (`agent[2].omega`) in `doc`, if there is one: what
+/// an override of `path` set, read back.
+#[must_use]
+pub fn get<'a>(doc: &'a Table, path: &str) -> Option<&'a Value> {
+    let segments = parse_path(path.trim()).ok()?;
+    let (last, parents) = segments.split_last()?;
+    let mut table = doc;
+    for (key, index) in parents {
+        let mut v = table.get(key)?;
+        if let Some(k) = index {
+            v = index_ref(v, key, *k).ok()?;
+        }
+        table = v.as_table()?;
+    }
+    let (key, index) = last;
+    let v = table.get(key)?;
+    match index {
+        Some(k) => index_ref(v, key, *k).ok(),
+        None => Some(v),
+    }
+}
+
 /// A path of `(key, index)` segments.
 type Segments = [(String, Option<usize>)];
 

@@ -7,7 +7,7 @@
 use super::dispersion::Dispersion;
 use super::error::{McError, io_at};
 use super::options::McOptions;
-use super::outcome::{End, Trace, TrialResult, classify};
+use super::outcome::{End, Trace, TrialResult};
 use super::plot;
 use super::report::{self, McSummary};
 use super::trial::{Base, Prepared, Ran, run_in_process, run_processes};
@@ -69,6 +69,7 @@ pub fn load_base(o: &McOptions) -> Result<Base, McError> {
         seed: o.seed,
         loaded,
     };
+    base.check_params()?;
     base.prepare(0)?;
     Ok(base)
 }
@@ -220,7 +221,10 @@ fn write_files(
     let files = layout::McLayout::new(dir);
     let write =
         |path: std::path::PathBuf, text: &str| std::fs::write(&path, text).map_err(io_at(&path));
-    write(files.trials(), &report::trials_csv(results))?;
+    write(
+        files.trials(),
+        &report::trials_csv(&base.dispersion, results),
+    )?;
     let ids: Vec<u32> = (base.loaded.scenario.agents.iter()).map(|a| a.id).collect();
     let mut initial = format!("{}\n", report::INITIAL_HEADER);
     for r in results {
@@ -251,6 +255,8 @@ pub struct Alone {
     pub summary: crate::results::Summary,
     /// The trial's `trials.csv` row, computed from the run's `errors.csv`.
     pub result: TrialResult,
+    /// The header of that row ([`report::trials_header`]).
+    pub header: String,
     /// The `attsync run …` command line that reproduces it.
     pub command: String,
 }
@@ -289,12 +295,13 @@ pub fn trial_alone(
         (_, Some(why)) => End::Failed(why.clone()),
         _ => End::Complete,
     };
-    let result = classify(k, prepared.seed, end, &trace, &o.judging);
+    let result = prepared.classify(end, &trace, &o.judging);
     let command = run_command(o, &prepared);
     Ok(Alone {
         prepared,
         summary,
         result,
+        header: report::trials_header(&base.dispersion),
         command,
     })
 }

@@ -12,6 +12,7 @@
 //! - [`haar`]: the sampler (Haar-uniform rotations, bounded vectors), pure.
 //! - `seed`: per-trial seeds (SplitMix64 of the master seed) and streams (ChaCha8).
 //! - [`draws`]: one trial's draws, in a fixed order, as `--set` overrides.
+//! - [`params`]: the draws of `[[monte_carlo.param]]` fields (their own stream).
 //! - [`trial`]: one trial prepared (draws resolved into the scenario) and run.
 //! - [`outcome`]: what a trial records ([`Trace`]) and its classification.
 //! - [`stats`]: exact binomial (Clopper–Pearson) bounds.
@@ -27,6 +28,7 @@ mod error;
 pub mod haar;
 pub mod options;
 pub mod outcome;
+pub mod params;
 mod plot;
 pub mod report;
 mod seed;

@@ -171,6 +171,10 @@ pub struct TrialResult {
     /// Why a diverged or failed trial stopped.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// The values of the `[[monte_carlo.param]]` fields the trial ran
+    /// with, in file order, read back from its scenario.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub params: Vec<f64>,
 }
 
 /// Classifies a trial that ended as `end` with `trace` recorded, by its
@@ -207,6 +211,7 @@ pub fn classify(trial: u64, seed: u64, end: End, trace: &Trace, judging: &Judgin
         t_end: trace.t.last().copied().unwrap_or(0.0),
         settle,
         reason,
+        params: Vec::new(),
     }
 }
 

@@ -28,10 +28,22 @@ fn opt(x: Option<f64>) -> String {
     x.map_or(String::new(), |v| v.to_string())
 }
 
+/// The header of `trials.csv`: [`TRIALS_HEADER`], then one column per
+/// `[[monte_carlo.param]]` field, named by its path.
+#[must_use]
+pub fn trials_header(dispersion: &Dispersion) -> String {
+    let mut s = TRIALS_HEADER.to_string();
+    for p in &dispersion.params {
+        s.push(',');
+        s += &p.field;
+    }
+    s
+}
+
 /// One `trials.csv` row (no newline).
 #[must_use]
 pub fn trial_row(r: &TrialResult) -> String {
-    format!(
+    let mut row = format!(
         "{},{},{},{},{},{},{},{},{},{},{}",
         r.trial,
         r.seed,
@@ -44,13 +56,15 @@ pub fn trial_row(r: &TrialResult) -> String {
         opt(r.settle.att_1e6),
         opt(r.settle.angvel_1e3),
         opt(r.settle.angvel_1e6)
-    )
+    );
+    cells(&mut row, &r.params, true);
+    row
 }
 
 /// `trials.csv`.
 #[must_use]
-pub fn trials_csv(results: &[TrialResult]) -> String {
-    let mut s = format!("{TRIALS_HEADER}\n");
+pub fn trials_csv(dispersion: &Dispersion, results: &[TrialResult]) -> String {
+    let mut s = format!("{}\n", trials_header(dispersion));
     for r in results {
         s += &trial_row(r);
         s.push('\n');

@@ -46,6 +46,8 @@ pub struct Prepared {
     pub draws: Draws,
     /// The trial's overrides only (after the user's).
     pub overrides: Vec<String>,
+    /// The `[[monte_carlo.param]]` fields' values in its scenario.
+    pub params: Vec<f64>,
     /// The scenario with every override, resolved.
     pub loaded: Loaded,
 }
@@ -59,7 +61,11 @@ impl Base {
     pub fn prepare(&self, k: u64) -> Result<Prepared, ScenarioError> {
         let seed = trial_seed(self.seed, k);
         let draws = super::draws::draw(&self.dispersion, &mut trial_rng(seed));
-        let overrides = super::draws::overrides(&self.dispersion, &draws);
+        let mut overrides = super::draws::overrides(&self.dispersion, &draws);
+        let params = &self.dispersion.params;
+        let dt = self.loaded.resolved.network.dt;
+        let drawn = super::params::quantised(params, &super::params::draw(params, seed), dt);
+        overrides.extend(super::params::overrides(params, &drawn));
         let all: Vec<String> = self.set.iter().chain(&overrides).cloned().collect();
         let loaded = scenario::load_str_with(&self.file, &self.text, &all, self.check)?;
         Ok(Prepared {
@@ -67,8 +73,38 @@ impl Base {
             seed,
             draws,
             overrides,
+            params: super::params::used(&loaded, params),
             loaded,
         })
+    }
+
+    /// Checks that each `[[monte_carlo.param]]` field takes the ends of
+    /// its law (its bounds, or its mean) in a valid scenario.
+    ///
+    /// # Errors
+    /// The first scenario that is not valid, naming the field.
+    pub fn check_params(&self) -> Result<(), ScenarioError> {
+        for p in &self.dispersion.params {
+            for end in p.law.ends() {
+                let one = std::slice::from_ref(p);
+                let end = super::params::quantised(one, &[end], self.loaded.resolved.network.dt);
+                let with = super::params::overrides(one, &end);
+                let all: Vec<String> = self.set.iter().chain(&with).cloned().collect();
+                scenario::load_str_with(&self.file, &self.text, &all, self.check)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Prepared {
+    /// This trial's result, ended as `end` with `trace` ([`classify`]),
+    /// with the values of its dispersed fields.
+    #[must_use]
+    pub fn classify(&self, end: End, trace: &Trace, judging: &Judging) -> TrialResult {
+        let mut r = classify(self.trial, self.seed, end, trace, judging);
+        r.params.clone_from(&self.params);
+        r
     }
 }
 
@@ -122,7 +158,7 @@ pub fn run_in_process(p: &Prepared, judging: &Judging, interrupt: &Interrupt) ->
         ),
         None => End::Complete,
     };
-    Ran::Done(classify(p.trial, p.seed, end, &trace, judging))
+    Ran::Done(p.classify(end, &trace, judging))
 }
 
 /// Runs trial `p` as processes (its own iceoryx2 namespace; node logs in
@@ -168,7 +204,7 @@ pub fn run_processes(
         let again =
             end == End::Complete && until::goes_on(trace.verdict(judging).kind) && net.steps < max;
         if !again {
-            return Ok(Ran::Done(classify(p.trial, p.seed, end, &trace, judging)));
+            return Ok(Ran::Done(p.classify(end, &trace, judging)));
         }
         net.steps = until::next_horizon(net.steps, max, net.sample_every);
     }

@@ -17,12 +17,27 @@ fn opt(x: Option<f64>) -> String {
     x.map_or(String::new(), |v| v.to_string())
 }
 
+/// The header of `sweep.csv`: [`CSV_HEADER`] for one field; for a grid,
+/// its first column is the two fields' paths (`network.delay,
+/// scheme.control.k_r`).
+#[must_use]
+pub fn csv_header(o: &SweepOptions) -> String {
+    match &o.grid {
+        Some(g) => CSV_HEADER.replacen("value", &format!("{},{}", o.param, g.param), 1),
+        None => CSV_HEADER.to_string(),
+    }
+}
+
 /// One row of `sweep.csv`.
 fn csv_row(r: &SweepRow) -> String {
     let s = &r.settle;
+    let value = match &r.value2 {
+        Some(v2) => format!("{},{v2}", r.value),
+        None => r.value.clone(),
+    };
     format!(
         "{},{},{},{},{},{},{},{},{},{},{},{},{}",
-        r.value,
+        value,
         r.verdict.kind.name(),
         opt(r.verdict.decay_rate),
         opt(r.linear_rate),
@@ -46,7 +61,7 @@ pub(super) fn write(
     rows: &[SweepRow],
     margin: Option<&MarginResult>,
 ) -> Result<(), SweepError> {
-    let mut csv = format!("{CSV_HEADER}\n");
+    let mut csv = format!("{}\n", csv_header(o));
     for r in rows {
         let _ = writeln!(csv, "{}", csv_row(r));
     }
@@ -56,6 +71,7 @@ pub(super) fn write(
     let tolerance = o.run.judging.tolerance;
     let info = serde_json::json!({
         "param": o.param,
+        "grid": o.grid.as_ref().map(|g| &g.param),
         "criterion": format!(
             "verdict from the largest attitude error over agents over the whole run \
              (docs/verdicts.md); converged: below {tolerance} and staying there; \
@@ -71,13 +87,17 @@ pub(super) fn write(
     let info = serde_json::to_string_pretty(&info).expect("json") + "\n";
     let file = layout.json();
     std::fs::write(&file, &info).map_err(io_at(&file))?;
-    super::plot::draw(&layout.svg(), &o.param, base, rows, margin)
-        .map_err(|e| SweepError::Plot(e.0))?;
+    match &o.grid {
+        Some(g) => super::grid_plot::draw(&layout.svg(), (&o.param, &g.param), o, rows),
+        None => super::plot::draw(&layout.svg(), &o.param, base, rows, margin),
+    }
+    .map_err(|e| SweepError::Plot(e.0))?;
     let file = layout.summary();
     std::fs::write(&file, &info).map_err(io_at(&file))
 }
 
-/// The table printed at the end.
+/// The table printed at the end (`param`: the swept fields, joined by
+/// `,` for a grid).
 #[must_use]
 pub fn table(param: &str, r: &SweepResult) -> String {
     let mut s = format!(
@@ -100,7 +120,10 @@ pub fn table(param: &str, r: &SweepResult) -> String {
         let _ = writeln!(
             s,
             "{:>14} {:>11} {:>14} {:>14} {:>14.3e} {:>16} {:>12}",
-            row.value,
+            match &row.value2 {
+                Some(v2) => format!("{},{v2}", row.value),
+                None => row.value.clone(),
+            },
             if row.complete || row.verdict.kind == attsync_verdict::Kind::Diverging {
                 row.verdict.kind.name()
             } else {

@@ -1,6 +1,8 @@
-//! `attsync sweep`: one scenario over a list of values of one field, runs in
+//! `attsync sweep`: one scenario over a list of values of one field, or
+//! over the grid of two fields' values ([`Axis`]: every value of the first
+//! with every value of the second, drawn as a stability chart), runs in
 //! parallel (each isolated), and the bisection that finds the stability
-//! boundary (`--find-margin`).
+//! boundary of one field (`--find-margin`).
 //!
 //! Each run is judged by its verdict (`docs/verdicts.md`, `attsync_verdict`):
 //! read from the largest attitude error over agents over the whole run, not
@@ -19,10 +21,11 @@
 //! ([`jobs_and_threads`]).
 
 mod files;
+mod grid_plot;
 pub mod margin;
 mod plot;
 
-pub use files::{CSV_HEADER, table};
+pub use files::{CSV_HEADER, csv_header, table};
 pub use margin::{LinearMargin, MarginResult};
 
 use crate::interrupt::Interrupt;
@@ -47,6 +50,9 @@ pub struct SweepOptions {
     pub param: String,
     /// Values (TOML literals).
     pub values: Vec<String>,
+    /// A second field: every value of `param` runs with every value of
+    /// this one (a grid, drawn as a stability chart).
+    pub grid: Option<Axis>,
     /// Parallel runs (≥ 1; [`default_jobs`]).
     pub jobs: usize,
     /// Other overrides applied to every run.
@@ -58,6 +64,97 @@ pub struct SweepOptions {
     pub find_margin: Option<Bisection>,
     /// What validation does with a step beyond RK4's stable one (`--no-stiffness-check`).
     pub stiffness: StiffnessCheck,
+}
+
+/// A second swept field and its values (TOML literals).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// Field path, as for `--set`.
+    pub param: String,
+    /// Values (TOML literals).
+    pub values: Vec<String>,
+}
+
+/// One run's point of the sweep: the value of the first field and, in a
+/// grid, of the second.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// The value of [`SweepOptions::param`].
+    pub value: String,
+    /// The value of the grid's second field ([`SweepOptions::grid`]).
+    pub value2: Option<String>,
+}
+
+impl Point {
+    /// A point of the first field only.
+    #[must_use]
+    pub fn of(value: &str) -> Self {
+        Self {
+            value: value.to_string(),
+            value2: None,
+        }
+    }
+
+    /// The run's name in `runs/`: both values joined by `_`.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match &self.value2 {
+            Some(v2) => format!("{}_{v2}", self.value),
+            None => self.value.clone(),
+        }
+    }
+}
+
+impl SweepOptions {
+    /// Every point to run: the values of `param`, each with every value of
+    /// the grid's second field (the first field fastest).
+    #[must_use]
+    pub fn points(&self) -> Vec<Point> {
+        let Some(g) = &self.grid else {
+            return self.values.iter().map(|v| Point::of(v)).collect();
+        };
+        (g.values.iter())
+            .flat_map(|v2| {
+                self.values.iter().map(move |v| Point {
+                    value: v.clone(),
+                    value2: Some(v2.clone()),
+                })
+            })
+            .collect()
+    }
+
+    /// The swept fields: `param`, and the grid's second.
+    #[must_use]
+    pub fn params(&self) -> Vec<&str> {
+        let mut all = vec![self.param.as_str()];
+        all.extend(self.grid.as_ref().map(|g| g.param.as_str()));
+        all
+    }
+
+    /// The overrides of the run at `p`: `set`, then `param=value` (and
+    /// the second field's).
+    #[must_use]
+    pub fn overrides(&self, p: &Point) -> Vec<String> {
+        let mut with = overrides(&self.set, &self.param, &p.value);
+        if let (Some(g), Some(v2)) = (&self.grid, &p.value2) {
+            with.push(format!("{}={v2}", g.param));
+        }
+        with
+    }
+
+    /// Loads the scenario with `set`, and checks that every point makes a
+    /// valid scenario too (in a grid, every pair of values); returns the
+    /// scenario without the swept fields.
+    ///
+    /// # Errors
+    /// The first invalid scenario.
+    pub fn load_checked(&self) -> Result<Loaded, ScenarioError> {
+        let loaded = scenario::load_with(&self.scenario, &self.set, self.stiffness)?;
+        for p in self.points() {
+            scenario::load_with(&self.scenario, &self.overrides(&p), self.stiffness)?;
+        }
+        Ok(loaded)
+    }
 }
 
 /// How the margin is bisected.
@@ -78,6 +175,9 @@ impl SweepOptions {
     /// The first option out of its range.
     pub fn validate(&self) -> Result<(), OptionError> {
         options::count("--jobs", self.jobs as u64, 1, u64::MAX)?;
+        if let Some(g) = &self.grid {
+            grid_conflict(&self.param, g, self.find_margin.is_some())?;
+        }
         if let Some(b) = self.find_margin {
             options::count(
                 "--bisect",
@@ -91,6 +191,26 @@ impl SweepOptions {
         }
         self.run.validate()
     }
+}
+
+/// A grid that cannot run: a field twice, no values, or `--find-margin`
+/// (a bisection of one field).
+fn grid_conflict(param: &str, g: &Axis, find_margin: bool) -> Result<(), OptionError> {
+    let conflict = |why: String| Err(OptionError::Conflict(why));
+    if g.param == param {
+        return conflict(format!("--param {param} is given twice"));
+    }
+    if g.values.is_empty() {
+        return conflict(format!("--param {}: no --values", g.param));
+    }
+    if find_margin {
+        return conflict(format!(
+            "--find-margin bisects one field: give one --param (the grid of {param} and {} \
+             draws the chart; its linear boundary is `attsync margin` per value)",
+            g.param
+        ));
+    }
+    Ok(())
 }
 
 /// Why a sweep produced no results.
@@ -253,6 +373,8 @@ pub fn jobs_and_threads(jobs: Option<usize>, threads: Option<usize>) -> (usize, 
 pub struct SweepRow {
     /// The value, as given.
     pub value: String,
+    /// In a grid, the value of the second field.
+    pub value2: Option<String>,
     /// Largest final attitude error over agents.
     pub final_max_att_err: f64,
     /// When every agent had settled ([`Settle::latest`] of the agents').
@@ -300,14 +422,11 @@ fn run_one(
     o: &SweepOptions,
     dir: &Path,
     k: usize,
-    value: &str,
+    point: &Point,
     interrupt: &Interrupt,
 ) -> Result<SweepRow, SweepError> {
-    let loaded = scenario::load_with(
-        &o.scenario,
-        &overrides(&o.set, &o.param, value),
-        o.stiffness,
-    )?;
+    let loaded = scenario::load_with(&o.scenario, &o.overrides(point), o.stiffness)?;
+    let value = &point.label();
     let name = crate::results::layout::sweep_run_name(k, value);
     let opts = RunOptions {
         out: SweepLayout::new(dir).run(k, value).root().to_owned(),
@@ -315,8 +434,11 @@ fn run_one(
         ..o.run.clone()
     };
     let s = run(&loaded, &opts, interrupt).map_err(|source| SweepError::Run {
-        param: o.param.clone(),
-        value: value.to_string(),
+        param: o.params().join(", "),
+        value: match &point.value2 {
+            Some(v2) => format!("{}, {v2}", point.value),
+            None => point.value.clone(),
+        },
         source,
     })?;
     let linear_rate = attitude::linear::Linearisation::of(&loaded.resolved.network)
@@ -328,7 +450,8 @@ fn run_one(
         .clone()
         .unwrap_or_else(|| o.run.judging.verdict(&[]));
     Ok(SweepRow {
-        value: value.to_string(),
+        value: point.value.clone(),
+        value2: point.value2.clone(),
         final_max_att_err: s.max_final_att_err,
         settle,
         converged: verdict.kind == Kind::Converged,
@@ -345,19 +468,19 @@ fn interrupted(interrupt: &Interrupt) -> SweepError {
     SweepError::Interrupted(interrupt.signal().unwrap_or(signal_hook::consts::SIGINT))
 }
 
-/// Runs `values` with up to `jobs` at once. An interrupt stops the sweep.
+/// Runs `points` with up to `jobs` at once. An interrupt stops the sweep.
 fn run_many(
     o: &SweepOptions,
     dir: &Path,
     first: usize,
-    values: &[String],
+    points: &[Point],
     interrupt: &Interrupt,
 ) -> Result<Vec<SweepRow>, SweepError> {
     let out = crate::pool::run(
-        values.len(),
+        points.len(),
         o.jobs,
         || interrupt.is_set(),
-        |k| Flow::Next(run_one(o, dir, first + k, &values[k], interrupt)),
+        |k| Flow::Next(run_one(o, dir, first + k, &points[k], interrupt)),
     );
     if interrupt.is_set() {
         return Err(interrupted(interrupt));
@@ -375,12 +498,12 @@ fn run_many(
 /// See [`SweepError`]; an interrupted sweep leaves nothing behind.
 pub fn sweep(o: &SweepOptions, interrupt: &Interrupt) -> Result<SweepResult, SweepError> {
     o.validate()?;
-    let base = load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
+    let base = o.load_checked()?;
     let o = &margin::settled_for_margin(o, &base);
     interrupt.arm();
     let staging = Staging::new(&o.run.out).map_err(io_at(&o.run.out))?;
     let dir = staging.path().to_owned();
-    let mut rows = run_many(o, &dir, 0, &o.values, interrupt)?;
+    let mut rows = run_many(o, &dir, 0, &o.points(), interrupt)?;
     let margin = match o.find_margin {
         Some(b) => {
             let quantum = b
@@ -449,8 +572,8 @@ fn bisect(
                 break;
             }
         }
-        let value = format!("{mid}");
-        let row = run_many(o, dir, rows.len(), std::slice::from_ref(&value), interrupt)?.remove(0);
+        let point = Point::of(&format!("{mid}"));
+        let row = run_many(o, dir, rows.len(), std::slice::from_ref(&point), interrupt)?.remove(0);
         if row.decays() {
             lo = mid;
         } else {
@@ -489,6 +612,7 @@ mod tests {
             scenario: paper(),
             param: "network.delay".into(),
             values: vec!["0".into(), "0.1".into()],
+            grid: None,
             jobs: 2,
             set: Vec::new(),
             run: RunOptions {

@@ -15,8 +15,8 @@ use std::path::Path;
 /// Points of the linear curve of a swept delay.
 const CURVE_POINTS: usize = 120;
 
-/// The colour of a verdict's dot.
-fn colour(kind: Kind) -> RGBColor {
+/// The colour of a verdict's dot (and of a grid's cell).
+pub(super) fn colour(kind: Kind) -> RGBColor {
     match kind {
         Kind::Converged => GREEN,
         Kind::Converging => RGBColor(0, 130, 200),

@@ -125,7 +125,7 @@ fn alone(o: &McOptions, k: u64, name: Option<String>, interrupt: &Interrupt) -> 
     };
     let t = mc::trial_alone(o, k, &out, interrupt)?;
     println!("{}", t.summary.table());
-    println!("{}", report::TRIALS_HEADER);
+    println!("{}", t.header);
     println!("{}", report::trial_row(&t.result));
     println!("reproduce: {}", t.command);
     println!("results: {}", out.display());

@@ -1,24 +1,28 @@
-//! `attsync sweep`: one field of a scenario over many values, in parallel,
-//! and optionally the bisection for the margin.
+//! `attsync sweep`: one field of a scenario over many values, or two over
+//! their grid, in parallel, and optionally the bisection for the margin.
 
 use super::{EngineArgs, HostsArgs, ScenarioArgs, UntilArgs};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
+use attsync::options::OptionError;
 use attsync::run::{Engine, RunOptions};
 use attsync::scenario::StiffnessCheck;
-use attsync::sweep::{self, Bisection, SweepOptions};
+use attsync::sweep::{self, Axis, Bisection, SweepOptions};
 use std::path::PathBuf;
 
-/// `attsync sweep SCENARIO --param FIELD --values V1,V2,… […]`.
+/// `attsync sweep SCENARIO --param FIELD --values V1,V2,… [--param FIELD2
+/// --values W1,W2,…] […]`.
 #[derive(Debug, clap::Args)]
 pub struct Sweep {
     #[command(flatten)]
     pub scenario: ScenarioArgs,
-    /// Field to sweep, as for --set (e.g. network.delay, network.loss, scheme.control.k_r).
-    #[arg(long)]
-    pub param: String,
-    /// Values, comma-separated (TOML literals).
-    #[arg(long, value_delimiter = ',', required = true)]
+    /// Field to sweep, as for --set (e.g. network.delay, network.loss,
+    /// scheme.control.k_r); give it twice, each with its --values, to run
+    /// the grid of both (sweep.svg: the stability chart).
+    #[arg(long, required = true)]
+    pub param: Vec<String>,
+    /// Values of the --param before it, comma-separated (TOML literals).
+    #[arg(long, required = true)]
     pub values: Vec<String>,
     /// Runs at once [default: in-process, the number of cores (or cores / --threads); processes, as many runs as fit the cores (nodes × runs ≤ cores), at least 1].
     #[arg(long)]
@@ -61,10 +65,12 @@ pub struct Sweep {
 pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
     let hosts = a.hosts.load()?;
     let (jobs, threads) = sweep::jobs_and_threads(a.jobs, a.threads);
+    let (param, values, grid) = axes(a.param, a.values)?;
     let mut o = SweepOptions {
         scenario: a.scenario.scenario.clone(),
-        param: a.param,
-        values: a.values,
+        param,
+        values,
+        grid,
         jobs,
         set: a.scenario.overrides.set.clone(),
         run: RunOptions {
@@ -84,7 +90,7 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
         stiffness: StiffnessCheck::from_flag(a.no_stiffness_check),
     };
     o.validate()?;
-    let base = sweep::load_checked(&o.scenario, &o.set, &o.param, &o.values, o.stiffness)?;
+    let base = o.load_checked()?;
     let net = &base.resolved.network;
     o.run.judging = a
         .until
@@ -108,10 +114,33 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
         (Engine::InProcess, None) => {}
     }
     if a.out.is_none() {
-        o.run.out = sweep::default_out(&base, &o.param);
+        o.run.out = sweep::default_out(&base, &o.params().join("-"));
     }
     let r = sweep::sweep(&o, interrupt)?;
-    print!("{}", sweep::table(&o.param, &r));
+    print!("{}", sweep::table(&o.params().join(","), &r));
     println!("results: {}", o.run.out.display());
     Ok(())
+}
+
+/// The first field and its values, and the grid's second field if given:
+/// one or two `--param`, each with its `--values`.
+fn axes(
+    mut params: Vec<String>,
+    values: Vec<String>,
+) -> Result<(String, Vec<String>, Option<Axis>), OptionError> {
+    let split = |v: String| v.split(',').map(str::to_string).collect::<Vec<_>>();
+    let mut values: Vec<Vec<String>> = values.into_iter().map(split).collect();
+    if params.len() > 2 || params.len() != values.len() {
+        return Err(OptionError::Conflict(format!(
+            "--param is given {} times and --values {} times: give one or two --param, \
+             each followed by its --values",
+            params.len(),
+            values.len()
+        )));
+    }
+    let grid = (params.len() == 2).then(|| Axis {
+        param: params.remove(1),
+        values: values.remove(1),
+    });
+    Ok((params.remove(0), values.remove(0), grid))
 }

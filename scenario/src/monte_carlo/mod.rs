@@ -11,6 +11,13 @@
 //! Attitudes are drawn Haar-uniformly on SO(3), vectors with a uniform
 //! direction (the orchestrator's `mc::haar`). Every field can be set from the command
 //! line like any other (`--set monte_carlo.omega_max=2`).
+//!
+//! Any numeric field can be drawn too, each from its own law
+//! (`[[monte_carlo.param]]`, [`param`]).
+
+pub mod param;
+
+pub use param::{Dispersed, Law};
 
 use crate::Issue;
 use crate::schema::{ReferenceKind, Scenario, SchemeKind};
@@ -37,6 +44,9 @@ pub struct MonteCarloSpec {
     /// Disperse the leader's initial state too (default false).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leader: Option<bool>,
+    /// Numeric fields drawn per trial (`[[monte_carlo.param]]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub param: Option<Vec<param::ParamSpec>>,
 }
 
 /// An agent's initial value that can be drawn.
@@ -110,6 +120,8 @@ pub struct Dispersion {
     pub sigma_max: f64,
     /// The leader's draws.
     pub leader: LeaderDispersion,
+    /// Numeric fields drawn per trial, in file order.
+    pub params: Vec<Dispersed>,
     /// Number of `[[agent]]` entries (draws are made for each, in file order).
     #[serde(skip)]
     pub agents: usize,
@@ -147,6 +159,7 @@ impl Dispersion {
             (true, ReferenceKind::Constant) => LeaderDispersion::Attitude,
             (true, ReferenceKind::TimeVarying) => LeaderDispersion::State,
         };
+        let params = param::check(spec.param.as_deref().unwrap_or_default(), &mut issues);
         if !issues.is_empty() {
             return Err(issues);
         }
@@ -155,6 +168,7 @@ impl Dispersion {
             omega_max,
             sigma_max,
             leader,
+            params,
             agents: scenario.agents.len(),
         })
     }
