@@ -546,6 +546,9 @@ fn summarise(
         verdict: Some(judged.verdict),
         until: judged.until,
         hosts: opts.hosts.as_ref().and_then(hosts_summary),
+        outside_theory: (loaded.resolved.outside_theory.iter())
+            .map(ToString::to_string)
+            .collect(),
     }
 }
 
@@ -602,6 +605,7 @@ fn manifest(
         complete: summary.complete,
         incomplete_reason: (summary.incomplete_reason.as_ref()).map(ToString::to_string),
         diverged: summary.diverged.is_some(),
+        outside_theory: summary.outside_theory.clone(),
         ..Manifest::now(started)
     }
 }

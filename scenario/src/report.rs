@@ -44,6 +44,12 @@ pub fn describe(l: &Loaded) -> String {
         let _ = write!(s, "{sep}0→{a}");
     }
     s.push('\n');
+    if !r.outside_theory.is_empty() {
+        s.push_str("outside the theory ([graph] assumptions = \"off\"):\n");
+        for d in &r.outside_theory {
+            let _ = writeln!(s, "  - {d}: {}", d.lost());
+        }
+    }
     let (lo, hi) = r.spectrum_extremes;
     let _ = writeln!(
         s,

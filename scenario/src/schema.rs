@@ -35,6 +35,9 @@ pub struct Scenario {
     /// Communication impairments (default: an ideal network).
     #[serde(default)]
     pub network: NetworkSpec,
+    /// `[graph]`: whether the paper's Assumption 1 is enforced.
+    #[serde(default, skip_serializing_if = "GraphSpec::is_default")]
+    pub graph: GraphSpec,
     /// The envelope of a sane state (default: `attitude::guard::Envelope::default`).
     #[serde(default, skip_serializing_if = "GuardSpec::is_unset")]
     pub guard: GuardSpec,
@@ -332,6 +335,36 @@ pub struct ObserverInit {
     /// `σ̂ᵢ(0)`, rad/s² (scheme 1).
     #[serde(default)]
     pub sigma: Option<[f64; 3]>,
+}
+
+/// `[graph]`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GraphSpec {
+    /// `"strict"` (default): a scenario outside Assumption 1 (a cycle, an
+    /// agent the leader does not reach, no leader link) is refused;
+    /// `"off"`: it runs, marked `outside_theory`.
+    #[serde(default)]
+    pub assumptions: Assumptions,
+}
+
+impl GraphSpec {
+    /// Whether it is as if absent.
+    #[must_use]
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// `[graph] assumptions`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Assumptions {
+    /// Assumption 1 holds or the scenario is refused.
+    #[default]
+    Strict,
+    /// Departures from Assumption 1 are allowed and reported.
+    Off,
 }
 
 /// `[[edge]]`.

@@ -183,6 +183,7 @@ fn draw_tree(p: &TreeParams) -> Scenario {
         agents,
         edges,
         network: Default::default(),
+        graph: Default::default(),
         guard: Default::default(),
         monte_carlo: None,
     }

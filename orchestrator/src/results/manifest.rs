@@ -80,6 +80,9 @@ pub struct Manifest {
     pub incomplete_reason: Option<String>,
     /// Whether it stopped because a state left the envelope.
     pub diverged: bool,
+    /// How the scenario leaves the paper's Assumption 1 (as `summary.json`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outside_theory: Vec<String>,
     /// The machine.
     pub platform: Platform,
     /// Every other file of the directory.
@@ -220,6 +223,7 @@ impl Manifest {
             complete: false,
             incomplete_reason: None,
             diverged: false,
+            outside_theory: Vec::new(),
             platform: Platform::read(),
             files: Vec::new(),
         }

@@ -177,6 +177,10 @@ pub struct Summary {
     /// A run across hosts (`--hosts`): the hosts and how the links were secured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hosts: Option<HostsSummary>,
+    /// How the scenario leaves the paper's Assumption 1 (`[graph]
+    /// assumptions = "off"`), each said in words; absent inside the theory.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub outside_theory: Vec<String>,
 }
 
 /// The hosts of a run across machines, and its links' security.

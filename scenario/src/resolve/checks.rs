@@ -5,6 +5,7 @@
 use super::ctx::Ctx;
 use super::graph::{Adjacency, LeaderLinks};
 use super::ids::Ids;
+use super::theory::Departure;
 use attitude::checks::{
     appendix_d_min_eigenvalue_from_extremes, xi_plus_laplacian, xi_plus_laplacian_extremes,
 };
@@ -36,13 +37,23 @@ pub(super) fn reachability(
             }
         }
     }
+    let mut unreachable = Vec::new();
     for (r, (id, k)) in ids.iter().enumerate() {
-        if !reached[r] {
+        if !reached[r] && !c.theory_off {
             c.err(
                 format!("agent[{k}]"),
-                format!("agent {id} is not reachable from the leader: no [[leader_link]] in its connected component (Assumption 1)"),
+                format!("agent {id} is not reachable from the leader: no [[leader_link]] in its connected component (Assumption 1; `[graph] assumptions = \"off\"` allows it)"),
             );
+        } else if !reached[r] {
+            unreachable.push(id);
         }
+    }
+    if !unreachable.is_empty() {
+        unreachable.sort_unstable();
+        let d = Departure::Unreachable {
+            agents: unreachable,
+        };
+        c.departures.push(d);
     }
 }
 

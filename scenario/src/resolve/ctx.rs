@@ -6,6 +6,7 @@
 //! problem, not for each of 10⁵ valid agents.
 
 use super::Issue;
+use super::theory::Departure;
 use crate::schema::MatrixSpec;
 use attitude::checks::{has_distinct_eigenvalues, is_spd, sym_eigenvalues};
 use nalgebra::{Matrix3, Vector3};
@@ -22,9 +23,27 @@ pub(super) struct Ctx {
     pub(super) errors: Vec<Issue>,
     /// Problems that do not.
     pub(super) warnings: Vec<Issue>,
+    /// `[graph] assumptions = "off"`: departures from Assumption 1 are
+    /// recorded, not refused.
+    pub(super) theory_off: bool,
+    /// The departures recorded.
+    pub(super) departures: Vec<Departure>,
 }
 
 impl Ctx {
+    /// A departure from Assumption 1 at `field`: an error saying `reason`,
+    /// or with `[graph] assumptions = "off"` recorded.
+    pub(super) fn departs(&mut self, field: impl Into<String>, d: Departure, reason: String) {
+        if self.theory_off {
+            self.departures.push(d);
+        } else {
+            self.err(
+                field,
+                format!("{reason} (Assumption 1; `[graph] assumptions = \"off\"` allows it)"),
+            );
+        }
+    }
+
     pub(super) fn err(&mut self, field: impl Into<String>, reason: impl Into<String>) {
         self.errors.push(Issue {
             field: field.into(),

@@ -3,6 +3,7 @@
 
 use super::ctx::Ctx;
 use super::ids::Ids;
+use super::theory::Departure;
 use crate::schema::{EdgeSpec, LeaderLinkSpec};
 pub(super) use attitude::sparse::Adjacency;
 use nalgebra::Matrix3;
@@ -86,10 +87,14 @@ pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &Ids) -> Edges {
                 map.insert(key, k);
             }
             if joined {
-                c.err(
-                    format!("{f}.agents"),
-                    format!("edge {}–{} closes a cycle: the follower graph must be a forest (Assumption 1)", key.0, key.1),
+                let reason = format!(
+                    "edge {}–{} closes a cycle: the follower graph must be a forest",
+                    key.0, key.1
                 );
+                let cycle = Departure::Cycle {
+                    edge: [key.0, key.1],
+                };
+                c.departs(format!("{f}.agents"), cycle, reason);
             } else {
                 dsu.union(ra, rb);
             }
@@ -165,10 +170,8 @@ pub(super) fn leader_links(c: &mut Ctx, specs: &[LeaderLinkSpec], ids: &Ids) -> 
         out.gain[r] = g;
     }
     if specs.is_empty() {
-        c.err(
-            "leader_link",
-            "at least one [[leader_link]] is required: no agent hears the leader",
-        );
+        let reason = "at least one [[leader_link]] is required: no agent hears the leader";
+        c.departs("leader_link", Departure::NoLeaderLink, reason.into());
     }
     out
 }

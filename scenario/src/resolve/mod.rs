@@ -35,9 +35,11 @@ mod rotation;
 mod scheme;
 mod simulation;
 mod stiffness;
+mod theory;
 
 pub use ctx::MAX_STEPS;
 pub use stiffness::{REFUSE_FACTOR, StiffnessCheck, WARN_FROM, stable_dt};
+pub use theory::Departure;
 
 use super::schema::{Output, Scenario, SchemeKind, Simulation};
 use attitude::network::{Network, Scheme};
@@ -84,6 +86,9 @@ pub struct Resolved {
     pub stiffness: Option<Estimate>,
     /// Agents run by the user's own programs.
     pub plugins: Vec<super::plugin::Plugin>,
+    /// How the scenario leaves Assumption 1 (`[graph] assumptions =
+    /// "off"`); empty inside the paper's theory.
+    pub outside_theory: Vec<Departure>,
 }
 
 /// Validates `s` and resolves it into a [`Network`], refusing a
@@ -96,7 +101,10 @@ pub fn resolve(s: &Scenario) -> Result<Resolved, Vec<Issue>> {
 /// As [`resolve`], with the stiffness verdict `check` (the step-size phase
 /// runs last, on an otherwise valid scenario).
 pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec<Issue>> {
-    let mut c = Ctx::default();
+    let mut c = Ctx {
+        theory_off: s.graph.assumptions == crate::schema::Assumptions::Off,
+        ..Ctx::default()
+    };
     let kind = s.scheme.kind;
     simulation::name(&mut c, s.name.as_ref());
     let time = simulation::simulation(&mut c, &s.simulation, &s.output);
@@ -147,6 +155,17 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
+    if !c.departures.is_empty() {
+        let said: Vec<String> = c.departures.iter().map(ToString::to_string).collect();
+        c.warn(
+            theory::FIELD,
+            format!(
+                "outside the paper's theory ({}): its guarantees do not cover this run \
+                 (`attsync check` says what is lost)",
+                said.join("; ")
+            ),
+        );
+    }
     Ok(Resolved {
         network,
         warnings: c.warnings,
@@ -157,6 +176,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         appendix_d_min_eig: spectrum.appendix_d_min_eig,
         stiffness: estimate,
         plugins: Vec::new(),
+        outside_theory: c.departures,
     })
 }
 
@@ -186,6 +206,13 @@ impl Resolved {
     #[must_use]
     pub fn law_warning(&self) -> Option<&Issue> {
         self.warnings.iter().find(|w| w.field == scheme::LAW_FIELD)
+    }
+
+    /// The warning that the scenario is outside the paper's theory
+    /// (`[graph] assumptions = "off"` and a departure), if it is.
+    #[must_use]
+    pub fn theory_warning(&self) -> Option<&Issue> {
+        self.warnings.iter().find(|w| w.field == theory::FIELD)
     }
 }
 

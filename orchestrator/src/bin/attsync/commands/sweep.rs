@@ -99,7 +99,8 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
         // Every run places its own scenario again; the base, before any starts.
         attsync::hosts::Placement::of(h, &base.resolved.network)?;
     }
-    if let Some(w) = base.resolved.law_warning() {
+    let theory = base.resolved.theory_warning();
+    for w in base.resolved.law_warning().into_iter().chain(theory) {
         eprintln!("warning: {}: {w}", base.file.display());
     }
     let nodes = base.resolved.network.agents.len() + 1;
