@@ -42,10 +42,15 @@ impl Limits {
             .iter()
             .filter(|a| a.model.leader_gain.is_some())
             .count();
-        let max_degree = net
-            .agents
-            .iter()
+        // A node's state has as many readers as agents hear it: its
+        // neighbours on an undirected graph, more with one-way edges.
+        let mut readers: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+        for n in net.agents.iter().flat_map(|a| &a.model.neighbours) {
+            *readers.entry(n.id).or_default() += 1;
+        }
+        let max_degree = (net.agents.iter())
             .map(|a| a.model.neighbours.len())
+            .chain(readers.into_values())
             .max()
             .unwrap_or(0);
         Self {

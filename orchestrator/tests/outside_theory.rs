@@ -9,6 +9,9 @@
 //!   `manifest.json` carry `outside_theory`; a scenario inside the theory
 //!   has no such key;
 //! - both engines give byte-identical states for each departure;
+//! - one-way edges (`from`, `to`): only the receiver hears the sender —
+//!   turning an agent nobody hears changes only its own error history;
+//!   malformed, repeated or overlapping edges are refused naming them;
 //! - physics: an agent nobody reaches moves as if alone — changing another
 //!   agent's initial attitude leaves its error history bit for bit.
 
@@ -42,6 +45,13 @@ fn unreachable(text: String) -> String {
     text.replace(edge, "")
 }
 
+/// Edge 4–5 one-way, from 5 to 4: 4 hears 5, 5 does not hear 4.
+fn one_way(text: String) -> String {
+    let edge = "[[edge]]\nagents = [4, 5]\n";
+    assert!(text.contains(edge));
+    text.replace(edge, "[[edge]]\nfrom = 5\nto = 4\n")
+}
+
 /// Without any `[[leader_link]]`.
 fn no_leader(text: String) -> String {
     let mut out = String::new();
@@ -63,8 +73,9 @@ fn no_leader(text: String) -> String {
 
 type Edit = fn(String) -> String;
 
-const CASES: [(&str, Edit, &str); 3] = [
+const CASES: [(&str, Edit, &str); 4] = [
     ("cycle", cycle, "edge 1–5 closes a cycle"),
+    ("one-way", one_way, "edge 5→4 is one-way"),
     (
         "unreachable",
         unreachable,
@@ -140,18 +151,86 @@ fn outside_the_theory_check_says_what_is_lost_and_runs_are_marked() {
     );
 }
 
+/// The `errors.csv` rows of agent `id` in `out`.
+fn rows_of(out: &Path, id: &str) -> Vec<String> {
+    let text = read(&out.join("errors.csv"));
+    (text.lines())
+        .filter(|l| l.split(',').nth(1) == Some(id))
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn a_one_way_edge_carries_states_one_way_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = scenario(tmp.path(), "one-way", true, one_way);
+    let f = file.to_str().unwrap();
+    let run = |name: &str, set: &[&str]| {
+        let out = tmp.path().join(name);
+        let mut sets = vec!["simulation.duration=3"];
+        sets.extend_from_slice(set);
+        attsync(tmp.path(), &run_args(f, "in-process", &out, &sets)).assert_code(0);
+        out
+    };
+    let turn = |k: usize| format!("agent[{k}].attitude={{axis=[0.0, 0.0, 1.0], angle_pi=0.5}}");
+    let base = run("base", &[]);
+    // Agent 4 (agent[3]) turned: nobody hears it, so only its own rows change.
+    let four = run("four", &[&turn(3)]);
+    for id in ["1", "2", "3", "5", "6", "7"] {
+        assert_eq!(rows_of(&base, id), rows_of(&four, id), "agent {id}");
+    }
+    assert_ne!(rows_of(&base, "4"), rows_of(&four, "4"));
+    // Agent 5 (agent[4]) turned: 4 hears it.
+    let five = run("five", &[&turn(4)]);
+    assert_ne!(rows_of(&base, "4"), rows_of(&five, "4"));
+}
+
+#[test]
+fn bad_edges_are_refused_naming_the_edge() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "both-forms",
+            "\n[[edge]]\nagents = [6, 7]\nfrom = 6\ngain = [3.0, 2.0, 1.0]\n",
+            "give `agents = [i, j]`",
+        ),
+        (
+            "from-only",
+            "\n[[edge]]\nfrom = 6\ngain = [3.0, 2.0, 1.0]\n",
+            "give `agents = [i, j]`",
+        ),
+        (
+            "twice",
+            "\n[[edge]]\nfrom = 6\nto = 7\ngain = [3.0, 2.0, 1.0]\n\n[[edge]]\nfrom = 6\nto = 7\ngain = [3.0, 2.0, 1.0]\n",
+            "duplicate edge 6→7",
+        ),
+        (
+            "over-an-edge",
+            "\n[[edge]]\nfrom = 3\nto = 5\ngain = [3.0, 2.0, 1.0]\n",
+            "agent 5 already hears agent 3",
+        ),
+    ];
+    for (name, extra, says) in cases {
+        let file = scenario(tmp.path(), name, true, |t| t + extra);
+        let o = attsync(tmp.path(), &["check".as_ref(), file.as_os_str()]);
+        o.assert_code(2);
+        assert!(o.stderr.contains(says), "{name}: {}", o.stderr);
+    }
+    // A link override against a one-way edge's direction.
+    let file = scenario(tmp.path(), "reverse-link", true, |t| {
+        one_way(t) + "\n[[network.link]]\nfrom = 4\nto = 5\ndelay = 0.01\n"
+    });
+    let o = attsync(tmp.path(), &["check".as_ref(), file.as_os_str()]);
+    o.assert_code(2);
+    assert!(o.stderr.contains("4 → 5 is not a link"), "{}", o.stderr);
+}
+
 #[test]
 fn an_agent_nobody_reaches_moves_as_if_alone() {
     let tmp = tempfile::tempdir().unwrap();
     let file = scenario(tmp.path(), "alone", true, unreachable);
     let f = file.to_str().unwrap();
-    let rows_of_4 = |out: &Path| -> Vec<String> {
-        let text = read(&out.join("errors.csv"));
-        (text.lines())
-            .filter(|l| l.split(',').nth(1) == Some("4"))
-            .map(str::to_string)
-            .collect()
-    };
+    let rows_of_4 = |out: &Path| rows_of(out, "4");
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
     let set_a = ["simulation.duration=3"];
     // Agent 1 (agent[0]) turned by 90° about z at t = 0.

@@ -33,11 +33,13 @@ pub fn describe(l: &Loaded) -> String {
     );
     let _ = writeln!(s, "agents:    {}", n.agents.len());
     agents(&mut s, n);
-    s.push_str("edges:     ");
-    for (k, (a, b)) in r.edges.iter().enumerate() {
-        let sep = if k == 0 { "" } else { ", " };
-        let _ = write!(s, "{sep}{a}–{b}");
-    }
+    let both = r.edges.iter().map(|(a, b)| format!("{a}–{b}"));
+    let one_way = r.arcs.iter().map(|(a, b)| format!("{a}→{b}"));
+    let _ = write!(
+        s,
+        "edges:     {}",
+        both.chain(one_way).collect::<Vec<_>>().join(", ")
+    );
     s.push_str("\nleader:    ");
     for (k, a) in r.leader_links.iter().enumerate() {
         let sep = if k == 0 { "" } else { ", " };

@@ -371,9 +371,19 @@ pub enum Assumptions {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EdgeSpec {
-    /// The two agent ids.
-    pub agents: [u32; 2],
-    /// `A_{i,j} = A_{j,i}` (or `Ǎ_{i,j}`): 3 numbers (diagonal) or 3 rows of 3.
+    /// The two agent ids of an undirected edge (the paper's: each hears
+    /// the other with the same gain).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub agents: Option<[u32; 2]>,
+    /// A one-way edge's sender (with `to`; only with `[graph]
+    /// assumptions = "off"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from: Option<u32>,
+    /// A one-way edge's receiver: agent `to` hears agent `from`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub to: Option<u32>,
+    /// `A_{i,j} = A_{j,i}` (or `Ǎ_{i,j}`), or a one-way edge's gain
+    /// `A_{to,from}`: 3 numbers (diagonal) or 3 rows of 3.
     pub gain: MatrixSpec,
 }
 

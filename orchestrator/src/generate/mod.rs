@@ -155,7 +155,9 @@ fn draw_tree(p: &TreeParams) -> Scenario {
     let (c_edge, c_link) = if has_obs { (10.0, 14.0) } else { (3.0, 5.0) };
     let edges = (2..=p.agents)
         .map(|k| EdgeSpec {
-            agents: [rng.random_range(1..k), k],
+            agents: Some([rng.random_range(1..k), k]),
+            from: None,
+            to: None,
             gain: diag(c_edge, rng.random_range(0.0..5.0)),
         })
         .collect();

@@ -287,7 +287,8 @@ fn observer(w: &mut impl fmt::Write, o: &ObserverInit) -> fmt::Result {
 /// One `[[edge]]`.
 fn edge(w: &mut impl fmt::Write, e: &EdgeSpec) -> fmt::Result {
     header(w, "[[edge]]")?;
-    writeln!(w, "agents = [{}, {}]", e.agents[0], e.agents[1])?;
+    let [a, b] = e.agents.expect("a generated edge is undirected");
+    writeln!(w, "agents = [{a}, {b}]")?;
     kv(w, "gain", Matrix(&e.gain))
 }
 

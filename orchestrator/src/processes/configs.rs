@@ -52,6 +52,22 @@ pub(super) fn plugin_of<'a>(
 /// the orchestrator names when its own timeout ends (it sees every node).
 pub const NODE_START_GRACE: f64 = 5.0;
 
+/// The agents that read each agent's state, ascending: those that count it
+/// among their neighbours (its own neighbours on an undirected graph; with
+/// one-way edges, only its edges' receivers).
+fn readers(net: &Network) -> std::collections::HashMap<u32, Vec<u32>> {
+    let mut by: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+    for a in &net.agents {
+        for n in &a.model.neighbours {
+            by.entry(n.id).or_default().push(a.model.id);
+        }
+    }
+    for ids in by.values_mut() {
+        ids.sort_unstable();
+    }
+    by
+}
+
 /// The per-node configurations of `net`.
 #[must_use]
 pub fn node_configs(
@@ -97,16 +113,17 @@ pub fn node_configs(
             initial: net.leader,
         },
     )];
+    let readers = readers(net);
     for a in &net.agents {
-        let nbrs: Vec<u32> = a.model.neighbours.iter().map(|n| n.id).collect();
-        let mut inputs = nbrs.clone();
+        let mut inputs: Vec<u32> = a.model.neighbours.iter().map(|n| n.id).collect();
         if a.model.leader_gain.is_some() {
             inputs.push(0);
         }
+        let outputs = readers.get(&a.model.id).cloned().unwrap_or_default();
         out.push(base(
             a.model.id,
             inputs,
-            nbrs,
+            outputs,
             Role::Agent {
                 model: Box::new(a.model.clone()),
                 initial: a.initial,

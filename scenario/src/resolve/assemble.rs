@@ -30,6 +30,8 @@ pub(super) struct Graph<'a> {
     pub(super) ids: &'a Ids,
     pub(super) edges: &'a Edges,
     pub(super) adjacency: &'a Adjacency,
+    /// The one-way edges into each agent ([`Edges::incoming`]).
+    pub(super) incoming: &'a [Vec<(u32, usize)>],
     pub(super) links: &'a LeaderLinks,
 }
 
@@ -108,6 +110,12 @@ fn neighbours(
             }
         })
         .collect();
+    let one_way = graph.incoming.get(r).into_iter().flatten();
+    neighbours.extend(one_way.map(|&(from, k)| Neighbour {
+        link: impaired.get(&(from, id)).copied(),
+        id: from,
+        a: graph.edges.arc_gain[k].expect("no errors"),
+    }));
     neighbours.sort_by_key(|n| n.id);
     neighbours
 }

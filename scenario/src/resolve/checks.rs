@@ -13,11 +13,12 @@ use attitude::network::Scheme;
 use nalgebra::{DMatrix, Matrix3};
 
 /// Every agent of `ids` must be reachable from the leader through edges
-/// (checked only when there is a leader link at all).
+/// (both ways) and one-way edges `arcs` (sender to receiver, by rank);
+/// checked only when there is a leader link at all.
 pub(super) fn reachability(
     c: &mut Ctx,
     ids: &Ids,
-    adj: &Adjacency,
+    (adj, arcs): (&Adjacency, &[(usize, usize)]),
     links: &LeaderLinks,
     any_link: bool,
 ) {
@@ -29,8 +30,13 @@ pub(super) fn reachability(
     for &r in &stack {
         reached[r] = true;
     }
+    let mut out: Vec<Vec<usize>> = vec![Vec::new(); if arcs.is_empty() { 0 } else { ids.len() }];
+    for &(a, b) in arcs {
+        out[a].push(b);
+    }
     while let Some(x) = stack.pop() {
-        for &(y, _) in adj.of(x) {
+        let one_way = out.get(x).into_iter().flatten().copied();
+        for y in adj.of(x).iter().map(|&(y, _)| y).chain(one_way) {
             if !reached[y] {
                 reached[y] = true;
                 stack.push(y);

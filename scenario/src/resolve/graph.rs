@@ -7,7 +7,7 @@ use super::theory::Departure;
 use crate::schema::{EdgeSpec, LeaderLinkSpec};
 pub(super) use attitude::sparse::Adjacency;
 use nalgebra::Matrix3;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::fmt;
 
 /// The follower edges that name two known, distinct agents.
@@ -17,6 +17,11 @@ pub(super) struct Edges {
     pub(super) pairs: Vec<(u32, u32)>,
     /// The gain of each pair, where the gain is valid.
     pub(super) gain: Vec<Option<Matrix3<f64>>>,
+    /// One-way edges (sender, receiver), in file order (`[graph]
+    /// assumptions = "off"` only).
+    pub(super) arcs: Vec<(u32, u32)>,
+    /// The gain of each one-way edge, where the gain is valid.
+    pub(super) arc_gain: Vec<Option<Matrix3<f64>>>,
 }
 
 /// The agents that hear the leader, by rank of their ids.
@@ -38,6 +43,22 @@ impl LeaderLinks {
 }
 
 impl Edges {
+    /// The one-way edges into each agent, by the receiver's rank: the
+    /// sender's id and the edge's index in `arcs`.
+    pub(super) fn incoming(&self, ids: &Ids) -> Vec<Vec<(u32, usize)>> {
+        let mut into = vec![Vec::new(); if self.arcs.is_empty() { 0 } else { ids.len() }];
+        for (k, &(from, to)) in self.arcs.iter().enumerate() {
+            into[ids.rank(to).expect("a known receiver")].push((from, k));
+        }
+        into
+    }
+
+    /// The one-way edges as (sender, receiver) ranks.
+    pub(super) fn arc_ranks(&self, ids: &Ids) -> Vec<(usize, usize)> {
+        let rank = |id| ids.rank(id).expect("an edge between known agents");
+        self.arcs.iter().map(|&(a, b)| (rank(a), rank(b))).collect()
+    }
+
     /// The pairs as pairs of ranks (every pair names known agents).
     pub(super) fn ranks(&self, ids: &Ids) -> Vec<(usize, usize)> {
         let rank = |id| ids.rank(id).expect("an edge between known agents");
@@ -56,11 +77,23 @@ pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &Ids) -> Edges {
     let mut index: Vec<usize> = Vec::with_capacity(specs.len());
     let mut first_edge: Option<HashMap<(u32, u32), usize>> = None;
     let mut dsu = Dsu::new(ids.len());
+    let mut one_way: Vec<(usize, &EdgeSpec)> = Vec::new();
     for (k, e) in specs.iter().enumerate() {
         let f = Edge(k);
-        let [a, b] = e.agents;
+        let [a, b] = match (e.agents, e.from, e.to) {
+            (Some(pair), None, None) => pair,
+            (None, Some(_), Some(_)) => {
+                one_way.push((k, e));
+                continue;
+            }
+            _ => {
+                let why = "give `agents = [i, j]` (both hear each other) or `from = i` and `to = j` (j hears i)";
+                c.err(format!("{f}"), why);
+                continue;
+            }
+        };
         let key = (a.min(b), a.max(b));
-        let ends = endpoints_ok(c, f, e.agents, ids).then(|| {
+        let ends = endpoints_ok(c, f, [a, b], ids).then(|| {
             let (ra, rb) = (ids.rank(key.0), ids.rank(key.1));
             (ra.expect("known"), rb.expect("known"))
         });
@@ -103,6 +136,77 @@ pub(super) fn edges(c: &mut Ctx, specs: &[EdgeSpec], ids: &Ids) -> Edges {
             index.push(k);
         }
     }
+    if !one_way.is_empty() {
+        arcs(c, &one_way, ids, &mut dsu, &mut out);
+    }
+    out
+}
+
+/// The one-way edges `specs` (with their file indices) into `out`: each
+/// a departure from Assumption 1; one that repeats an edge is refused,
+/// one that closes a cycle of the undirected skeleton (not its own
+/// reverse) is another departure.
+fn arcs(c: &mut Ctx, specs: &[(usize, &EdgeSpec)], ids: &Ids, dsu: &mut Dsu, out: &mut Edges) {
+    let both: HashSet<(u32, u32)> = out.pairs.iter().copied().collect();
+    let mut seen: HashMap<(u32, u32), usize> = HashMap::new();
+    for &(k, e) in specs {
+        let f = Edge(k);
+        let (from, to) = (e.from.expect("one-way"), e.to.expect("one-way"));
+        let g = c.gain(format_args!("{f}.gain"), &e.gain);
+        if !endpoints_ok(c, f, [from, to], ids) {
+            continue;
+        }
+        let key = (from.min(to), from.max(to));
+        if let Some(first) = seen.insert((from, to), k) {
+            c.err(
+                format!("{f}.to"),
+                format!("duplicate edge {from}→{to} (also edge[{first}])"),
+            );
+            continue;
+        }
+        if both.contains(&key) {
+            let why = format!(
+                "agent {to} already hears agent {from} through an edge `agents = [{}, {}]`",
+                key.0, key.1
+            );
+            c.err(format!("{f}.to"), why);
+            continue;
+        }
+        let reason = format!("edge {from}→{to} is one-way: the paper's edges are undirected");
+        c.departs(
+            format!("{f}.from"),
+            Departure::OneWay { edge: [from, to] },
+            reason,
+        );
+        let (ra, rb) = (ids.rank(from).expect("known"), ids.rank(to).expect("known"));
+        let reverse = seen.contains_key(&(to, from));
+        if !reverse && dsu.find(ra) == dsu.find(rb) {
+            let cycle = Departure::Cycle {
+                edge: [key.0, key.1],
+            };
+            c.departs(
+                format!("{f}.from"),
+                cycle,
+                format!("edge {from}→{to} closes a cycle"),
+            );
+        } else {
+            dsu.union(ra, rb);
+        }
+        out.arcs.push((from, to));
+        out.arc_gain.push(g);
+    }
+}
+
+/// The undirected skeleton of `pairs` and one-way `arcs` (by rank): every
+/// pair, then each arc's pair once unless a pair or its reverse is there.
+pub(super) fn skeleton(pairs: &[(usize, usize)], arcs: &[(usize, usize)]) -> Vec<(usize, usize)> {
+    if arcs.is_empty() {
+        return pairs.to_vec();
+    }
+    let key = |(a, b): (usize, usize)| (a.min(b), a.max(b));
+    let mut seen: HashSet<(usize, usize)> = pairs.iter().map(|&p| key(p)).collect();
+    let mut out = pairs.to_vec();
+    out.extend(arcs.iter().filter(|&&a| seen.insert(key(a))).copied());
     out
 }
 

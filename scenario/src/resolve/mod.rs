@@ -72,6 +72,9 @@ pub struct Resolved {
     pub warnings: Vec<Issue>,
     /// Follower edges as agent-id pairs (smaller id first), in file order.
     pub edges: Vec<(u32, u32)>,
+    /// One-way follower edges (sender, receiver), in file order (`[graph]
+    /// assumptions = "off"` only).
+    pub arcs: Vec<(u32, u32)>,
     /// Agents that hear the leader, ascending.
     pub leader_links: Vec<u32>,
     /// Eigenvalues of `Ξ + LLᵀ`, ascending, only up to 50 agents (empty
@@ -116,9 +119,13 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     let edges = graph::edges(&mut c, &s.edges, &ids);
     let links = graph::leader_links(&mut c, &s.leader_links, &ids);
     let ranked = edges.ranks(&ids);
+    let arcs = edges.arc_ranks(&ids);
     let adjacency = graph::Adjacency::new(ids.len(), &ranked);
-    checks::reachability(&mut c, &ids, &adjacency, &links, !s.leader_links.is_empty());
-    let spectrum = checks::spectrum(&mut c, &ranked, &links, scheme.as_ref(), &leader.p);
+    let any_link = !s.leader_links.is_empty();
+    checks::reachability(&mut c, &ids, (&adjacency, &arcs), &links, any_link);
+    // One-way edges count once in the spectrum's graph (its undirected skeleton).
+    let skeleton = graph::skeleton(&ranked, &arcs);
+    let spectrum = checks::spectrum(&mut c, &skeleton, &links, scheme.as_ref(), &leader.p);
     let impaired = if time.dt > 0.0 && time.dt.is_finite() {
         network::network(&mut c, &s.network, time.dt, &edges, &links, &ids)
     } else {
@@ -137,10 +144,12 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         guard: envelope,
         law,
     };
+    let incoming = edges.incoming(&ids);
     let wiring = assemble::Graph {
         ids: &ids,
         edges: &edges,
         adjacency: &adjacency,
+        incoming: &incoming,
         links: &links,
     };
     let network = assemble::network(parts, &wiring);
@@ -171,6 +180,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         warnings: c.warnings,
         leader_links: links.linked().map(|r| ids.id(r)).collect(),
         edges: edges.pairs,
+        arcs: edges.arcs,
         spectrum: spectrum.eigenvalues,
         spectrum_extremes: (spectrum.lambda_min, spectrum.lambda_max),
         appendix_d_min_eig: spectrum.appendix_d_min_eig,

@@ -34,6 +34,7 @@ pub(super) fn network(
         directed.insert((a, b));
         directed.insert((b, a));
     }
+    directed.extend(edges.arcs.iter().copied());
     for r in links.linked() {
         directed.insert((0, ids.id(r)));
     }
@@ -63,7 +64,7 @@ fn overrides(
         if !directed.contains(&(l.from, l.to)) {
             c.err(
                 f.clone(),
-                format!("{} → {} is not a link of this network (follower edges go both ways; the leader is 0 and only sends to its leader_link agents)", l.from, l.to),
+                format!("{} → {} is not a link of this network (follower edges go both ways, one-way edges from → to; the leader is 0 and only sends to its leader_link agents)", l.from, l.to),
             );
             continue;
         }

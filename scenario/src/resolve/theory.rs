@@ -13,6 +13,11 @@ pub const FIELD: &str = "graph.assumptions";
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum Departure {
+    /// A one-way `[[edge]]` (`from`, `to`): only `to` hears `from`.
+    OneWay {
+        /// Sender and receiver.
+        edge: [u32; 2],
+    },
     /// `[[edge]]` closes a cycle of followers.
     Cycle {
         /// The edge's agents (smaller id first).
@@ -32,6 +37,11 @@ impl Departure {
     #[must_use]
     pub fn lost(&self) -> &'static str {
         match self {
+            Self::OneWay { .. } => {
+                "the paper's graph is undirected (A_ij = A_ji, a symmetric Laplacian): its \
+                 Lyapunov functions, and every guarantee built on them, assume each \
+                 neighbour hears the other"
+            }
             Self::Cycle { .. } => {
                 "the stability proofs use a forest (a full-rank incidence matrix); on a cycle \
                  other equilibria (\"twisted\" states) can be stable, so almost-global \
@@ -52,6 +62,7 @@ impl Departure {
 impl fmt::Display for Departure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
+            Self::OneWay { edge: [a, b] } => write!(f, "edge {a}→{b} is one-way"),
             Self::Cycle { edge: [a, b] } => write!(f, "edge {a}–{b} closes a cycle"),
             Self::Unreachable { agents } => {
                 let ids: Vec<String> = agents.iter().map(u32::to_string).collect();
