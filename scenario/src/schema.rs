@@ -367,9 +367,9 @@ pub enum Assumptions {
     Off,
 }
 
-/// `[[edge]]`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// `[[edge]]`: `agents` (both ways) or `from` and `to` (one way); with
+/// neither, `agents` is a missing field, as before one-way edges existed.
+#[derive(Debug, Clone, Serialize)]
 pub struct EdgeSpec {
     /// The two agent ids of an undirected edge (the paper's: each hears
     /// the other with the same gain).
@@ -385,6 +385,34 @@ pub struct EdgeSpec {
     /// `A_{i,j} = A_{j,i}` (or `Ǎ_{i,j}`), or a one-way edge's gain
     /// `A_{to,from}`: 3 numbers (diagonal) or 3 rows of 3.
     pub gain: MatrixSpec,
+}
+
+/// `[[edge]]` as written, before [`EdgeSpec`] asks for its ends.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EdgeFields {
+    #[serde(default)]
+    agents: Option<[u32; 2]>,
+    #[serde(default)]
+    from: Option<u32>,
+    #[serde(default)]
+    to: Option<u32>,
+    gain: MatrixSpec,
+}
+
+impl<'de> Deserialize<'de> for EdgeSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let e = EdgeFields::deserialize(d)?;
+        if e.agents.is_none() && e.from.is_none() && e.to.is_none() {
+            return Err(serde::de::Error::missing_field("agents"));
+        }
+        Ok(Self {
+            agents: e.agents,
+            from: e.from,
+            to: e.to,
+            gain: e.gain,
+        })
+    }
 }
 
 /// A 3×3 matrix: its diagonal or its rows.
