@@ -124,10 +124,10 @@ pub fn table(param: &str, r: &SweepResult) -> String {
                 Some(v2) => format!("{},{v2}", row.value),
                 None => row.value.clone(),
             },
-            if row.complete || row.verdict.kind == attsync_verdict::Kind::Diverging {
-                row.verdict.kind.name()
-            } else {
+            if row.failed() {
                 "FAILED"
+            } else {
+                row.verdict.kind.name()
             },
             rate(row.verdict.decay_rate),
             rate(row.linear_rate),

@@ -26,10 +26,10 @@ const KINDS: [Kind; 5] = [
 
 /// A cell's fill: its verdict's colour, black for a run that failed.
 fn fill(r: &SweepRow) -> RGBColor {
-    if r.complete || r.verdict.kind == Kind::Diverging {
-        colour(r.verdict.kind)
-    } else {
+    if r.failed() {
         BLACK
+    } else {
+        colour(r.verdict.kind)
     }
 }
 

@@ -407,6 +407,12 @@ impl SweepRow {
     pub fn decays(&self) -> bool {
         self.complete && matches!(self.verdict.kind, Kind::Converged | Kind::Converging)
     }
+
+    /// Whether the run failed: it ended early and not because it diverged.
+    #[must_use]
+    pub fn failed(&self) -> bool {
+        !self.complete && self.verdict.kind != Kind::Diverging
+    }
 }
 
 /// The sweep's result.

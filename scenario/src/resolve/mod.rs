@@ -164,17 +164,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
-    if !c.departures.is_empty() {
-        let said: Vec<String> = c.departures.iter().map(ToString::to_string).collect();
-        c.warn(
-            theory::FIELD,
-            format!(
-                "outside the paper's theory ({}): its guarantees do not cover this run \
-                 (`attsync check` says what is lost)",
-                said.join("; ")
-            ),
-        );
-    }
+    c.warnings.extend(theory::warning(&c.departures));
     Ok(Resolved {
         network,
         warnings: c.warnings,

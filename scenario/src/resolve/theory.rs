@@ -3,11 +3,29 @@
 //! only with `[graph] assumptions = "off"`, and what the paper then no
 //! longer guarantees.
 
+use super::Issue;
 use serde::Serialize;
 use std::fmt;
 
 /// The field of the warning of a scenario outside the theory.
 pub const FIELD: &str = "graph.assumptions";
+
+/// The one warning of a scenario with `departures` (none without).
+#[must_use]
+pub fn warning(departures: &[Departure]) -> Option<Issue> {
+    if departures.is_empty() {
+        return None;
+    }
+    let said: Vec<String> = departures.iter().map(ToString::to_string).collect();
+    Some(Issue {
+        field: FIELD.into(),
+        reason: format!(
+            "outside the paper's theory ({}): its guarantees do not cover this run \
+             (`attsync check` says what is lost)",
+            said.join("; ")
+        ),
+    })
+}
 
 /// A way the scenario leaves Assumption 1.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
