@@ -20,6 +20,7 @@ use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
 use crate::observer::{
     LeaderInput, omega_hat_dot_7b, omega_hat_dot_16b, r_hat_rate, sigma_hat_dot_7c,
 };
+use crate::timeline::{Absent, Due};
 use crate::verdict::Verdicts;
 use nalgebra::{Matrix3, Vector3};
 
@@ -81,6 +82,21 @@ pub fn agent_field(
         vec: [omega_dot(&model.inertia, &x.w, &tau), w_hat_dot, s_hat_dot],
     };
     (d, tau)
+}
+
+/// [`agent_field`] with the inputs `absent` says are out left out of
+/// every sum (the leader: as if the agent did not hear it).
+fn without(
+    model: &AgentModel,
+    gains: &[Matrix3<f64>],
+    x: &AgentState,
+    nbrs: &[Exchanged],
+    leader: Option<&Exchanged>,
+    absent: &mut Absent,
+) -> (AgentDerivative, Vector3<f64>) {
+    absent.keep(gains, nbrs);
+    let leader = leader.filter(|_| !absent.leader(gains.len()));
+    agent_field(model, &absent.gains, x, &absent.nbrs, leader)
 }
 
 /// Tangent vector of an agent's state: rates of `(Rᵢ, R̂ᵢ)` and `(ωᵢ, ω̂ᵢ, σ̂ᵢ)`.
@@ -157,6 +173,19 @@ pub struct Agent {
     peak_torque: f64,
     /// What proves the verdicts of this step's published values.
     verdicts: Verdicts,
+    /// What its timeline has done so far, for an agent with one (boxed:
+    /// most agents have none).
+    timed: Option<Box<Timed>>,
+}
+
+/// The state of an agent's timeline ([`crate::timeline`]).
+#[derive(Debug, Clone, Default)]
+struct Timed {
+    /// The retunes taken so far.
+    retuned: Due,
+    /// The inputs left out of the law now, for an agent with outages that
+    /// `forget`.
+    absent: Option<Absent>,
 }
 
 impl Agent {
@@ -166,18 +195,39 @@ impl Agent {
         let gains = model.neighbours.iter().map(|n| n.a).collect();
         let held_nbrs = vec![Exchanged::identity(); model.neighbours.len()];
         let held_leader = model.leader_gain.map(|_| Box::new(Exchanged::identity()));
-        let impaired = |l: &Option<LinkModel>| {
-            l.filter(LinkModel::is_impaired)
-                .map(|m| Box::new(Link::new(m)))
+        let timeline = model.timeline.as_deref();
+        let impaired = |l: &Option<LinkModel>, from: u32| {
+            let outages = timeline.map_or(&[][..], |t| t.outages_of(from));
+            match l.filter(LinkModel::is_impaired) {
+                None if outages.is_empty() => None,
+                m => Some(Box::new(Link::with_outages(
+                    m.unwrap_or_else(LinkModel::ideal),
+                    outages.to_vec(),
+                ))),
+            }
         };
-        let mut links: Vec<Option<Box<Link>>> =
-            model.neighbours.iter().map(|n| impaired(&n.link)).collect();
+        let mut links: Vec<Option<Box<Link>>> = model
+            .neighbours
+            .iter()
+            .map(|n| impaired(&n.link, n.id))
+            .collect();
         if model.leader_gain.is_some() {
-            links.push(impaired(&model.leader_link));
+            links.push(impaired(&model.leader_link, 0));
         }
         let rejected = vec![0; links.len()];
         let impaired = links.iter().any(Option::is_some);
-        Self {
+        let forgets = links.iter().flatten().any(|l| l.ever_forgets());
+        let timed = timeline.map(|_| {
+            Box::new(Timed {
+                retuned: Due::default(),
+                absent: forgets.then(|| Absent {
+                    now: vec![false; links.len()],
+                    ..Absent::default()
+                }),
+            })
+        });
+        let mut agent = Self {
+            timed,
             model,
             gains,
             rejected,
@@ -192,6 +242,33 @@ impl Agent {
             n: 0,
             peak_torque: 0.0,
             verdicts: Verdicts::default(),
+        };
+        agent.retune();
+        agent.left_out();
+        agent
+    }
+
+    /// Which inputs the law leaves out at the current step (outages that
+    /// `forget`), at a step's start only.
+    fn left_out(&mut self) {
+        let Some(absent) = self.timed.as_deref_mut().and_then(|t| t.absent.as_mut()) else {
+            return;
+        };
+        for (out, link) in absent.now.iter_mut().zip(&self.links) {
+            *out = link.as_deref().is_some_and(|l| l.forgotten_at(self.n));
+        }
+        absent.any = absent.now.iter().any(|&o| o);
+    }
+
+    /// Takes the gains of a retune due at the current step
+    /// ([`crate::timeline::Retune`]), at a step's start only.
+    fn retune(&mut self) {
+        let (Some(timeline), Some(timed)) = (self.model.timeline.as_deref(), &mut self.timed)
+        else {
+            return;
+        };
+        if let Some(r) = timed.retuned.at(&timeline.retune, self.n, |r| r.step) {
+            self.model.scheme = r.scheme;
         }
     }
 
@@ -348,13 +425,25 @@ impl Agent {
     /// Returns `true` when a step completed.
     pub fn advance(&mut self) -> bool {
         self.update_links();
-        let (d, tau) = agent_field(
-            &self.model,
-            &self.gains,
-            &self.stage_x,
-            &self.held_nbrs,
-            self.held_leader.as_deref(),
-        );
+        let leader = self.held_leader.as_deref();
+        let absent = self.timed.as_deref_mut().and_then(|t| t.absent.as_mut());
+        let (d, tau) = match absent.filter(|a| a.any) {
+            None => agent_field(
+                &self.model,
+                &self.gains,
+                &self.stage_x,
+                &self.held_nbrs,
+                leader,
+            ),
+            Some(a) => without(
+                &self.model,
+                &self.gains,
+                &self.stage_x,
+                &self.held_nbrs,
+                leader,
+                a,
+            ),
+        };
         self.finish_stage(&d, &tau)
     }
 
@@ -373,13 +462,12 @@ impl Agent {
                 }
             }
         }
-        let (d, tau) = agent_field(
-            &self.model,
-            &self.gains,
-            &self.stage_x,
-            nbrs,
-            self.held_leader.as_deref(),
-        );
+        let leader = self.held_leader.as_deref();
+        let absent = self.timed.as_deref_mut().and_then(|t| t.absent.as_mut());
+        let (d, tau) = match absent.filter(|a| a.any) {
+            None => agent_field(&self.model, &self.gains, &self.stage_x, nbrs, leader),
+            Some(a) => without(&self.model, &self.gains, &self.stage_x, nbrs, leader, a),
+        };
         self.finish_stage(&d, &tau)
     }
 
@@ -414,6 +502,10 @@ impl Agent {
                 self.step.restart(&next.vec);
                 self.stage_x = self.state;
                 self.n += 1;
+                if self.timed.is_some() {
+                    self.retune();
+                    self.left_out();
+                }
                 true
             }
             None => {

@@ -80,7 +80,7 @@ impl InProcess {
     /// Builds the nodes of `net`, to run on the calling thread.
     #[must_use]
     pub fn new(net: &Network) -> Self {
-        let leader = Leader::new(net.p, net.leader, net.dt);
+        let leader = Leader::new(net.p, net.leader, net.dt).with_repoints(net.repoint.clone());
         let agents: Vec<Agent> = net
             .agents
             .iter()

@@ -18,6 +18,7 @@
 //!   `gammai` as a negative control ([`control::ControlLaw`]).
 //! - [`network`]: the resolved network every engine runs.
 //! - [`link`]: delay, jitter, loss and per-link period, on the receiving side.
+//! - [`timeline`]: events in steps: link outages, retunes, repoints.
 //! - [`agent`]: one follower as a stage-by-stage stepper (the exchange protocol).
 //! - [`verdict`]: the verdict on a follower's own published values, proven within a step.
 //! - [`schedule`]: the stages `(n, s)` of a run and which are exchanges (every loop walks it).
@@ -48,4 +49,5 @@ pub mod so3;
 pub mod sparse;
 pub mod spectrum;
 pub mod stiffness;
+pub mod timeline;
 pub mod verdict;

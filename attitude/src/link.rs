@@ -21,12 +21,15 @@
 //! its initial state). With a constant delay of k steps the receiver uses
 //! at stage s of step n exactly the sender's stage-s state of step n − k:
 //! RK4 applied to the delay equation by the method of steps.
+//! A link may also be down for whole steps (an outage, [`crate::timeline`]):
+//! a message stamped in one is dropped after the draws above.
 //! `PROTOCOL.md` § 10.9 states all this for plug-ins.
 //!
 //! A link without impairments is not filtered at all, so an unimpaired run
 //! stays byte-identical to the plain engine.
 
 use crate::network::Exchanged;
+use crate::timeline::Outage;
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -71,6 +74,19 @@ pub struct LinkModel {
 }
 
 impl LinkModel {
+    /// A link that changes nothing (what an outage acts on when the link
+    /// has no impairment of its own).
+    #[must_use]
+    pub fn ideal() -> Self {
+        Self {
+            delay: 0,
+            jitter: 0,
+            loss: Loss::None,
+            period: None,
+            seed: 0,
+        }
+    }
+
     /// Whether the link changes anything.
     #[must_use]
     pub fn is_impaired(&self) -> bool {
@@ -165,12 +181,22 @@ pub struct Link {
     inflight: BinaryHeap<Reverse<InFlight>>,
     held: Option<(u64, u32, Exchanged)>,
     stats: LinkStats,
+    /// Steps in which the link carries nothing ([`crate::timeline`]).
+    outages: Vec<Outage>,
 }
 
 impl Link {
     /// A link with `model`.
     #[must_use]
     pub fn new(model: LinkModel) -> Self {
+        Self::with_outages(model, Vec::new())
+    }
+
+    /// A link with `model` that carries nothing during `outages`: a
+    /// message stamped in one is dropped after the loss and jitter draws
+    /// and counted as lost.
+    #[must_use]
+    pub fn with_outages(model: LinkModel, outages: Vec<Outage>) -> Self {
         Self {
             rng: SplitMix64(model.seed),
             model,
@@ -178,6 +204,7 @@ impl Link {
             inflight: BinaryHeap::new(),
             held: None,
             stats: LinkStats::default(),
+            outages,
         }
     }
 
@@ -216,6 +243,10 @@ impl Link {
         } else {
             0
         };
+        if self.outages.iter().any(|o| o.covers(m)) {
+            self.stats.lost += 1;
+            return;
+        }
         self.inflight.push(Reverse(InFlight {
             at: (m + self.model.delay + jitter, s),
             stamp: (m, s),
@@ -240,6 +271,19 @@ impl Link {
         self.stats.age_max = self.stats.age_max.max(age);
         self.stats.evaluations += 1;
         Some(x)
+    }
+
+    /// Whether the receiver leaves the input out of its law at step `n`
+    /// (an outage with `forget` covers it).
+    #[must_use]
+    pub fn forgotten_at(&self, n: u64) -> bool {
+        self.outages.iter().any(|o| o.forget && o.covers(n))
+    }
+
+    /// Whether any outage of the link says `forget`.
+    #[must_use]
+    pub fn ever_forgets(&self) -> bool {
+        self.outages.iter().any(|o| o.forget)
     }
 
     /// The link's counters.

@@ -9,6 +9,7 @@ use crate::control::{ControlGains, ControlLaw};
 use crate::link::LinkModel;
 use crate::observer::ObserverGains;
 use crate::reference::LeaderState;
+use crate::timeline::{AgentTimeline, Repoint};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -182,6 +183,11 @@ pub struct AgentModel {
     /// agent; absent: corrected, and then not written).
     #[serde(default, skip_serializing_if = "ControlLaw::is_corrected")]
     pub law: ControlLaw,
+    /// What the scenario's events do to this agent: outages of its inputs,
+    /// changes of its gains (`None`, and then not written, without events;
+    /// boxed: the agents' models are swept at every stage).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub timeline: Option<Box<AgentTimeline>>,
 }
 
 /// How often neighbours exchange states.
@@ -239,6 +245,10 @@ pub struct Network {
     /// The envelope every node's state must stay in ([`crate::guard`]).
     #[serde(default)]
     pub guard: crate::guard::Envelope,
+    /// Jumps of the constant reference, by ascending step (`set = {
+    /// "leader.attitude" = … }` events).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub repoint: Vec<Repoint>,
 }
 
 impl Network {

@@ -2,6 +2,7 @@
 
 use crate::integrate::{LieDerivative, LieState, Rkmk4};
 use crate::network::Exchanged;
+use crate::timeline::{Due, Repoint};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -79,6 +80,11 @@ pub struct Leader {
     /// and evaluated at).
     stage_x: LeaderState,
     dt: f64,
+    /// Jumps of a constant reference, by ascending step ([`Repoint`]).
+    repoint: Vec<Repoint>,
+    /// Current step index, and the jumps taken so far.
+    n: u64,
+    repointed: Due,
 }
 
 impl Leader {
@@ -91,6 +97,28 @@ impl Leader {
             step: Rkmk4::new(state.to_lie(), dt),
             stage_x: state,
             dt,
+            repoint: Vec::new(),
+            n: 0,
+            repointed: Due::default(),
+        }
+    }
+
+    /// This leader, with its constant reference jumping as `repoint` says
+    /// (by ascending step; a jump at step 0 replaces the initial `R₀`).
+    #[must_use]
+    pub fn with_repoints(mut self, repoint: Vec<Repoint>) -> Self {
+        self.repoint = repoint;
+        self.jump();
+        self
+    }
+
+    /// Takes the jump due at the current step, if any: the reference
+    /// restarts from the new `R₀` (at a step's start only).
+    fn jump(&mut self) {
+        if let Some(j) = self.repointed.at(&self.repoint, self.n, |j| j.step) {
+            self.state.r0 = j.r0;
+            self.step = Rkmk4::new(self.state.to_lie(), self.dt);
+            self.stage_x = self.state;
         }
     }
 
@@ -116,6 +144,10 @@ impl Leader {
                 self.state = LeaderState::from_lie(&next);
                 self.step = Rkmk4::new(next, self.dt);
                 self.stage_x = self.state;
+                self.n += 1;
+                if !self.repoint.is_empty() {
+                    self.jump();
+                }
                 true
             }
             None => {

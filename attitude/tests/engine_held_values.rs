@@ -64,6 +64,7 @@ fn chain(n: u32, dt: f64, steps: u64, coupling: Coupling) -> Network {
                 scheme: scheme(GAIN),
                 p,
                 law: Default::default(),
+                timeline: Default::default(),
             };
             let r = rot(0.5 + 0.7 * f64::from(id), &axis);
             let initial = AgentState {
@@ -95,6 +96,7 @@ fn chain(n: u32, dt: f64, steps: u64, coupling: Coupling) -> Network {
             omega_hat: wide,
             sigma_hat: wide,
         },
+        repoint: Vec::new(),
     }
 }
 

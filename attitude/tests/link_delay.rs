@@ -542,6 +542,7 @@ fn network(observerless: bool, links: Links, steps: u64) -> Network {
                 scheme: scheme(observerless),
                 p,
                 law: Default::default(),
+                timeline: Default::default(),
             },
             initial: AgentState {
                 r,
@@ -571,6 +572,7 @@ fn network(observerless: bool, links: Links, steps: u64) -> Network {
         coupling: Coupling::Continuous,
         sample_every: 1,
         guard: Default::default(),
+        repoint: Vec::new(),
     }
 }
 

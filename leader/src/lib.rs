@@ -22,7 +22,13 @@ impl LeaderNode {
     /// [`RoleError::Agent`] if `cfg` is an agent's.
     pub fn from_config(cfg: &NodeConfig) -> Result<Self, RoleError> {
         match &cfg.role {
-            Role::Leader { p, initial } => Ok(Self(Leader::new(*p, *initial, cfg.dt))),
+            Role::Leader {
+                p,
+                initial,
+                repoint,
+            } => Ok(Self(
+                Leader::new(*p, *initial, cfg.dt).with_repoints(repoint.clone()),
+            )),
             Role::Agent { .. } => Err(RoleError::Agent(cfg.id)),
         }
     }

@@ -60,6 +60,10 @@ pub enum Role {
         p: Matrix3<f64>,
         /// State at t = 0.
         initial: LeaderState,
+        /// Jumps of a constant reference (`set = { "leader.attitude" = … }`
+        /// events), by ascending step; empty (and then not written) without.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        repoint: Vec<attitude::timeline::Repoint>,
     },
     /// A follower.
     Agent {
@@ -224,6 +228,7 @@ mod tests {
             },
             p: Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.0, -0.7, 0.0, 0.7, 0.0),
             law,
+            timeline: Default::default(),
         };
         let r = attitude::so3::rot(std::f64::consts::PI / 7.0, &Vector3::new(0.6, 0.8, 0.0));
         NodeConfig {

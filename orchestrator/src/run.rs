@@ -549,6 +549,8 @@ fn summarise(
         outside_theory: (loaded.resolved.outside_theory.iter())
             .map(ToString::to_string)
             .collect(),
+        events: loaded.resolved.events.clone(),
+        unreachable: loaded.resolved.isolated.clone(),
     }
 }
 
@@ -571,9 +573,17 @@ fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Re
     } else {
         &[]
     };
-    plot::draw(&svg, &title, series, aoi).map_err(|plot::PlotError(message)| RunError::Plot {
-        path: svg.clone(),
-        message,
+    let marks: Vec<plot::Mark> = (summary.events.iter())
+        .map(|e| plot::Mark {
+            t: e.t,
+            label: e.what.to_string(),
+        })
+        .collect();
+    plot::draw(&svg, &title, series, aoi, &marks).map_err(|plot::PlotError(message)| {
+        RunError::Plot {
+            path: svg.clone(),
+            message,
+        }
     })?;
     results::write_summary(layout.root(), summary).map_err(written)
 }

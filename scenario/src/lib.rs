@@ -32,6 +32,7 @@ mod borrowed;
 pub mod deserialize;
 mod document;
 mod error;
+pub mod event;
 pub mod input;
 pub mod monte_carlo;
 pub mod overrides;

@@ -52,6 +52,12 @@ pub fn describe(l: &Loaded) -> String {
             let _ = writeln!(s, "  - {d}: {}", d.lost());
         }
     }
+    if !r.events.is_empty() {
+        s.push_str("events:\n");
+        for e in &r.events {
+            let _ = writeln!(s, "  - {e}");
+        }
+    }
     let (lo, hi) = r.spectrum_extremes;
     let _ = writeln!(
         s,

@@ -44,6 +44,10 @@ pub struct Scenario {
     /// `[monte_carlo]`: what `attsync mc` disperses (ignored by other commands).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub monte_carlo: Option<crate::monte_carlo::MonteCarloSpec>,
+    /// `[[event]]`: the timeline (links cut and restored, agents silenced,
+    /// gains and the reference changed), in any order.
+    #[serde(default, rename = "event", skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<crate::event::EventSpec>,
 }
 
 /// `[guard]`: the largest norms a node's state may reach before the run

@@ -67,13 +67,25 @@ def refuse_unsupported(cfg):
         raise ConfigRefused(f"coupling mode {mode!r}")
 
 
+# § 10.9: what an input with outages but a null ``link`` runs.
+IDEAL_LINK = {"delay": 0, "jitter": 0, "loss": {"kind": "none"}, "period": None, "seed": 0}
+
+
 def input_links(cfg):
-    """A :class:`Link` per impaired input (inputs order), None if ideal."""
+    """A :class:`Link` per impaired input (inputs order), None if ideal;
+    an input with outages (§ 10.10) is impaired."""
     model = cfg["role"]["model"]
-    specs = [n.get("link") for n in model["neighbours"]]
+    down = {d["from"]: d["outages"] for d in model.get("timeline", {}).get("down", [])}
+    specs = [(n.get("link"), n["id"]) for n in model["neighbours"]]
     if model.get("leader_gain") is not None:
-        specs.append(model.get("leader_link"))
-    return [Link(spec) if spec is not None else None for spec in specs]
+        specs.append((model.get("leader_link"), 0))
+    links = []
+    for spec, sender in specs:
+        outages = down.get(sender, [])
+        if spec is None and outages:
+            spec = IDEAL_LINK
+        links.append(Link(spec, outages) if spec is not None else None)
+    return links
 
 
 def is_exchange(coupling, n, s):
@@ -215,6 +227,7 @@ class Node:
         started = time.time_ns()
         self.report_sample(agent, 0)
         for n in range(steps):
+            agent.step_start(n, [link is not None and link.forgotten_at(n) for link in links])
             for s in range(4):
                 out = agent.stage_point(s)
                 if is_exchange(coupling, n, s):

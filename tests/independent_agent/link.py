@@ -23,7 +23,9 @@ class Link:
     """One impaired input: its random stream, messages in flight and the
     held (stamp, value)."""
 
-    def __init__(self, spec):
+    def __init__(self, spec, outages=()):
+        # § 10.9 / § 10.10: steps [from, to) in which the link carries nothing.
+        self.outages = list(outages)
         self.delay = int(spec.get("delay") or 0)
         self.jitter = int(spec.get("jitter") or 0)
         self.period = spec.get("period")
@@ -62,7 +64,14 @@ class Link:
             self.lost += 1
             return
         j = self.rng.next() % (self.jitter + 1) if self.jitter > 0 else 0
+        if any(o["from"] <= n < o["to"] for o in self.outages):
+            self.lost += 1
+            return
         self.flight.append(((n + self.delay + j, s), (n, s), x))
+
+    def forgotten_at(self, n):
+        """§ 10.9: whether an outage with ``forget`` leaves the input out of the law at step n."""
+        return any(o.get("forget", False) and o["from"] <= n < o["to"] for o in self.outages)
 
     def value_at(self, n, s):
         """Delivers what is due at (n, s); the held value, or None."""

@@ -45,6 +45,18 @@ class Agent:
         self.rk = m.Rkmk4(rots, vecs, float(cfg["dt"]))
         self.peak_torque = 0.0
         self.point = None
+        # § 10.10: gains from a step on; inputs left out of the law now.
+        self.retunes = model.get("timeline", {}).get("retune", [])
+        self.absent = [False] * len(self.inputs)
+
+    def step_start(self, n, absent):
+        """§ 10.10 at the start of step n: the last retune due by n, and the
+        inputs an outage with ``forget`` leaves out."""
+        for r in self.retunes:
+            if r["step"] <= n:
+                self.observer = r["scheme"].get("observer")
+                self.control = r["scheme"]["control"]
+        self.absent = absent
 
     # --- what travels ------------------------------------------------------
 
@@ -71,9 +83,11 @@ class Agent:
         held values, and advances the integrator."""
         (r, rh), (w, wh, sh) = self.point
         k_nb = len(self.gains)
-        neighbours = list(zip(self.gains, self.held[:k_nb]))
+        neighbours = [
+            (g, h) for g, h, out in zip(self.gains, self.held[:k_nb], self.absent) if not out
+        ]
         leader = None
-        if self.leader_gain is not None:
+        if self.leader_gain is not None and not self.absent[k_nb]:
             leader = (self.leader_gain, self.held[k_nb])
         if self.scheme == "observer-time-varying":
             wh_dot, sh_dot = m.observer_time_varying(

@@ -130,6 +130,25 @@ fn sampled_coupling_is_bit_identical() {
 }
 
 #[test]
+fn a_timeline_of_events_is_bit_identical() {
+    // PROTOCOL.md § 10.10: agent 3 holds a cut edge's last value, then
+    // leaves silent agent 5 out of its law; agent 1 loses the leader
+    // (removed); every agent is retuned.
+    let events = concat!(
+        "event=[{t=1.0, cut=[3,5]}, {t=2.0, restore=[3,5]}, ",
+        "{t=2.5, agent=5, action=\"silence\", hold=false}, {t=3.5, agent=5, action=\"resume\"}, ",
+        "{t=0.5, cut=[0,1], hold=false}, {t=1.5, restore=[0,1]}, ",
+        "{t=3.0, set={\"scheme.control.k_r\"=4.0, \"scheme.observer.k_sigma\"=9.0}}]"
+    );
+    assert_bit_identical(
+        "independent-events",
+        &paper("timevarying"),
+        &[0, 2, 4],
+        &[DURATION, events],
+    );
+}
+
+#[test]
 fn the_independent_agent_conforms() {
     let tmp = Sandbox::new("independent-conform");
     let r = conform_python(&tmp, &[], &agent_py());

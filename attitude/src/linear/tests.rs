@@ -158,6 +158,7 @@ pub(super) fn agent(
             scheme,
             p: Matrix3::zeros(),
             law: Default::default(),
+            timeline: Default::default(),
         },
         initial: AgentState {
             r: Matrix3::identity(),
@@ -244,6 +245,7 @@ pub(super) fn path3(scheme: Scheme, d: Delays, rotate: bool) -> Network {
         coupling: Coupling::Continuous,
         sample_every: 1,
         guard: Default::default(),
+        repoint: Vec::new(),
     }
 }
 
@@ -289,6 +291,7 @@ pub(super) fn paper7(scheme: Scheme, steps: u64) -> Network {
         coupling: Coupling::Continuous,
         sample_every: 1,
         guard: Default::default(),
+        repoint: Vec::new(),
     }
 }
 

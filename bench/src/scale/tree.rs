@@ -104,6 +104,7 @@ pub fn network(n: u32, scheme: SchemeArg, steps: u64) -> Network {
                 scheme: scheme.scheme(),
                 p,
                 law: Default::default(),
+                timeline: Default::default(),
             };
             let r = rot(0.1 + 0.01 * k, &axis);
             let initial = AgentState {
@@ -130,5 +131,6 @@ pub fn network(n: u32, scheme: SchemeArg, steps: u64) -> Network {
         coupling: Coupling::Continuous,
         sample_every: 10,
         guard: Default::default(),
+        repoint: Vec::new(),
     }
 }

@@ -27,7 +27,7 @@ impl Neighbourhood {
             .collect();
         let nbr_index = net.neighbour_indices();
         Self {
-            leader: Leader::new(net.p, net.leader, net.dt),
+            leader: Leader::new(net.p, net.leader, net.dt).with_repoints(net.repoint.clone()),
             agents,
             nbr_index,
             candidate,

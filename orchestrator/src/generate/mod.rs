@@ -188,5 +188,6 @@ fn draw_tree(p: &TreeParams) -> Scenario {
         graph: Default::default(),
         guard: Default::default(),
         monte_carlo: None,
+        events: Vec::new(),
     }
 }

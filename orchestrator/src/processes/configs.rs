@@ -111,6 +111,7 @@ pub fn node_configs(
         Role::Leader {
             p: net.p,
             initial: net.leader,
+            repoint: net.repoint.clone(),
         },
     )];
     let readers = readers(net);

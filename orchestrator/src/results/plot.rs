@@ -42,31 +42,47 @@ pub const OBSERVER_ANGVEL: &str = "observer angular velocity error ||what_i - w_
 /// Caption of the age-of-information panel.
 pub const AOI: &str = "age of information per link (ms): mean and max";
 
+/// A moment marked on every time axis: a vertical line, labelled in the
+/// first panel (a scenario's `[[event]]`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mark {
+    /// When, s.
+    pub t: f64,
+    /// What happened.
+    pub label: String,
+}
+
 /// Draws the panels into `file` (SVG): the errors of `series` (and their
-/// observer errors where they have them), and the age of information of
-/// `aoi` (real-time runs' links; empty: no such panel).
+/// observer errors where they have them) with `marks` on their time axes,
+/// and the age of information of `aoi` (real-time runs' links; empty: no
+/// such panel).
 pub fn draw(
     file: &Path,
     title: &str,
     series: &[Series],
     aoi: &[LinkSummary],
+    marks: &[Mark],
 ) -> Result<(), PlotError> {
     let observer = series.iter().any(|s| !s.obs_att.is_empty());
     let panels = 2 + if observer { 2 } else { 0 } + usize::from(!aoi.is_empty());
     let root = canvas(file, (1000, PANEL_HEIGHT * panels as u32), title)?;
     let areas = root.split_evenly((panels, 1));
-    panel(&areas[0], "attitude error |R_i R_0^T|_I", series, |s| {
-        &s.att
-    })?;
+    let labelled = (marks, true);
+    let unlabelled = (marks, false);
     panel(
-        &areas[1],
-        "angular velocity error ||w_i - w_0|| (rad/s)",
+        &areas[0],
+        "attitude error |R_i R_0^T|_I",
         series,
-        |s| &s.angvel,
+        labelled,
+        |s| &s.att,
     )?;
+    let angvel = "angular velocity error ||w_i - w_0|| (rad/s)";
+    panel(&areas[1], angvel, series, unlabelled, |s| &s.angvel)?;
     if observer {
-        panel(&areas[2], OBSERVER_ATT, series, |s| &s.obs_att)?;
-        panel(&areas[3], OBSERVER_ANGVEL, series, |s| &s.obs_angvel)?;
+        panel(&areas[2], OBSERVER_ATT, series, unlabelled, |s| &s.obs_att)?;
+        panel(&areas[3], OBSERVER_ANGVEL, series, unlabelled, |s| {
+            &s.obs_angvel
+        })?;
     }
     if let Some(area) = areas.last().filter(|_| !aoi.is_empty()) {
         aoi_bars(area, aoi)?;
@@ -125,6 +141,7 @@ fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     label: &str,
     series: &[Series],
+    (marks, labelled): (&[Mark], bool),
     pick: impl Fn(&Series) -> &[f64],
 ) -> Result<(), PlotError> {
     let t_end = series
@@ -162,7 +179,36 @@ fn panel<DB: DrawingBackend>(
             line(&mut chart, floored(points), color.stroke_width(2), name)?;
         }
     }
+    mark(&mut chart, marks, (lo, hi), labelled)?;
     legend(&mut chart, SeriesLabelPosition::UpperRight)
+}
+
+/// `marks` as grey vertical lines over `lo..hi`, with their labels if `labelled`.
+fn mark<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    marks: &[Mark],
+    (lo, hi): (f64, f64),
+    labelled: bool,
+) -> Result<(), PlotError>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let grey = BLACK.mix(0.45);
+    for m in marks {
+        let rule = PathElement::new(vec![(m.t, lo), (m.t, hi)], grey.stroke_width(1));
+        chart
+            .draw_series(std::iter::once(rule))
+            .map_err(PlotError::of)?;
+        if labelled {
+            let font = ("sans-serif", 13).into_font().color(&BLACK.mix(0.75));
+            let text = Text::new(format!(" {}", m.label), (m.t, hi), font);
+            chart
+                .draw_series(std::iter::once(text))
+                .map_err(PlotError::of)?;
+        }
+    }
+    Ok(())
 }
 
 /// The errors of `agents` agents as their band `b`: shaded from the
@@ -322,7 +368,7 @@ mod tests {
     fn svg(series: &[Series], aoi: &[LinkSummary]) -> String {
         let tmp = tempfile::tempdir().expect("tempdir");
         let file = tmp.path().join("errors.svg");
-        draw(&file, "t", series, aoi).expect("drawn");
+        draw(&file, "t", series, aoi, &[]).expect("drawn");
         std::fs::read_to_string(file).expect("written")
     }
 

@@ -181,6 +181,14 @@ pub struct Summary {
     /// assumptions = "off"`), each said in words; absent inside the theory.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub outside_theory: Vec<String>,
+    /// The scenario's `[[event]]`s in time order (`docs/events.md`);
+    /// absent without.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<crate::scenario::resolve::Event>,
+    /// Agents the events left unreachable from the leader, and when;
+    /// absent when none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unreachable: Vec<crate::scenario::resolve::Isolation>,
 }
 
 /// The hosts of a run across machines, and its links' security.

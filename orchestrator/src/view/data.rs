@@ -27,6 +27,19 @@ pub struct RunInfo {
     pub incomplete_reason: Option<String>,
     /// Real-time factor, `None` for lockstep.
     pub realtime: Option<f64>,
+    /// The scenario's events, marked on the timeline and the error plots
+    /// (absent without).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<EventMark>,
+}
+
+/// An event on the page's timeline.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EventMark {
+    /// When, s.
+    pub t: f64,
+    /// What happened (`cut 3–5`).
+    pub label: String,
 }
 
 /// One body: where it stands and its box.

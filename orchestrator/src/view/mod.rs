@@ -129,6 +129,12 @@ pub fn run_info(s: &Summary) -> RunInfo {
         complete: s.complete,
         incomplete_reason: (s.incomplete_reason.as_ref()).map(ToString::to_string),
         realtime: s.realtime,
+        events: (s.events.iter())
+            .map(|e| data::EventMark {
+                t: e.t,
+                label: e.what.to_string(),
+            })
+            .collect(),
     }
 }
 

@@ -313,8 +313,40 @@
       });
       g.stroke();
     }));
+    marks(g, fr, X);
     p.image = img;
     p.X = X;
+  }
+
+  /** The run's events as dashed vertical lines, labelled, on a plot. */
+  function marks(g, fr, X) {
+    g.setLineDash([3 * fr.dpr, 3 * fr.dpr]);
+    g.strokeStyle = 'rgba(255,214,102,0.7)';
+    g.fillStyle = 'rgba(255,214,102,0.9)';
+    g.lineWidth = fr.dpr;
+    g.textAlign = 'left';
+    for (const e of D.run.events || []) {
+      const x = X(e.t);
+      g.beginPath(); g.moveTo(x, fr.t); g.lineTo(x, fr.b); g.stroke();
+      g.fillText(e.label, x + 3 * fr.dpr, fr.t + 10 * fr.dpr);
+    }
+    g.setLineDash([]);
+  }
+
+  /** The run's events as tick marks of the time slider. */
+  function eventTicks() {
+    const events = D.run.events || [];
+    if (!events.length) return;
+    const list = document.createElement('datalist');
+    list.id = 'events';
+    for (const e of events) {
+      const o = document.createElement('option');
+      o.value = String(Math.round(((e.t - T0) / (T1 - T0 || 1)) * 10000));
+      o.label = e.label;
+      list.appendChild(o);
+    }
+    document.body.appendChild(list);
+    $('scrub').setAttribute('list', 'events');
   }
 
   function niceStep(x) {
@@ -453,6 +485,7 @@
 
   describe();
   controls();
+  eventTicks();
   readHash();
   resize();
   draw();

@@ -11,6 +11,7 @@ use attitude::guard::Envelope;
 use attitude::link::LinkModel;
 use attitude::network::{AgentModel, AgentSpec, Neighbour, Network, Scheme};
 use attitude::reference::LeaderState;
+use attitude::timeline::{AgentTimeline, InputOutages, Outage, Repoint, Retune};
 use std::collections::BTreeMap;
 
 /// Everything resolved, error-free.
@@ -23,6 +24,34 @@ pub(super) struct Parts {
     pub(super) impaired: BTreeMap<(u32, u32), LinkModel>,
     pub(super) guard: Envelope,
     pub(super) law: ControlLaw,
+    pub(super) timeline: Timed,
+}
+
+/// What the events do, in steps.
+pub(super) struct Timed {
+    /// Outages by directed link (sender, receiver).
+    pub(super) down: BTreeMap<(u32, u32), Vec<Outage>>,
+    /// The same for every agent.
+    pub(super) retune: Vec<Retune>,
+    /// The leader's.
+    pub(super) repoint: Vec<Repoint>,
+}
+
+impl Timed {
+    /// Agent `id`'s part.
+    fn of(&self, id: u32, inputs: impl Iterator<Item = u32>) -> Option<Box<AgentTimeline>> {
+        let down = inputs
+            .filter_map(|from| {
+                let outages = self.down.get(&(from, id))?.clone();
+                Some(InputOutages { from, outages })
+            })
+            .collect();
+        let t = AgentTimeline {
+            down,
+            retune: self.retune.clone(),
+        };
+        (!t.is_empty()).then(|| Box::new(t))
+    }
 }
 
 /// The graph the agents are wired by.
@@ -48,6 +77,7 @@ pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
         impaired,
         guard,
         law,
+        timeline,
     } = parts;
     let scheme = scheme.expect("no errors");
     let p = leader.p;
@@ -57,12 +87,15 @@ pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
         .map(|(r, body)| {
             let (inertia, a_bar, initial) = body.expect("no errors");
             let id = graph.ids.id(r);
+            let neighbours = neighbours(id, r, graph, &impaired);
+            let inputs = neighbours.iter().map(|n| n.id).chain(std::iter::once(0));
             AgentSpec {
                 model: AgentModel {
+                    timeline: timeline.of(id, inputs),
                     id,
                     inertia,
                     a_bar,
-                    neighbours: neighbours(id, r, graph, &impaired),
+                    neighbours,
                     leader_gain: graph.links.gain[r],
                     leader_link: impaired.get(&(0, id)).copied(),
                     scheme,
@@ -86,6 +119,7 @@ pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
         coupling: time.coupling.expect("no errors"),
         sample_every: time.sample_every.expect("no errors"),
         guard,
+        repoint: timeline.repoint,
     }
 }
 

@@ -26,6 +26,7 @@ mod agents;
 mod assemble;
 mod checks;
 mod ctx;
+mod events;
 mod graph;
 mod guard;
 mod ids;
@@ -38,6 +39,7 @@ mod stiffness;
 mod theory;
 
 pub use ctx::MAX_STEPS;
+pub use events::{Event, Isolation, What};
 pub use stiffness::{REFUSE_FACTOR, StiffnessCheck, WARN_FROM, stable_dt};
 pub use theory::Departure;
 
@@ -92,6 +94,10 @@ pub struct Resolved {
     /// How the scenario leaves Assumption 1 (`[graph] assumptions =
     /// "off"`); empty inside the paper's theory.
     pub outside_theory: Vec<Departure>,
+    /// The `[[event]]`s, in time order, as the run reports them.
+    pub events: Vec<Event>,
+    /// Agents the events cut off from the leader, and when.
+    pub isolated: Vec<Isolation>,
 }
 
 /// Validates `s` and resolves it into a [`Network`], refusing a
@@ -132,6 +138,16 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         BTreeMap::new()
     };
     let envelope = guard::guard(&mut c, &s.guard);
+    let world = events::World {
+        dt: time.dt,
+        steps: time.steps.unwrap_or(0),
+        scheme,
+        reference: s.leader.reference,
+        ids: &ids,
+        edges: &edges,
+        links: &links,
+    };
+    let timeline = events::events(&mut c, &s.events, &world);
     if !c.errors.is_empty() {
         return Err(c.errors);
     }
@@ -143,6 +159,11 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         impaired,
         guard: envelope,
         law,
+        timeline: assemble::Timed {
+            down: timeline.down,
+            retune: timeline.retune,
+            repoint: timeline.repoint,
+        },
     };
     let incoming = edges.incoming(&ids);
     let wiring = assemble::Graph {
@@ -177,6 +198,8 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         stiffness: estimate,
         plugins: Vec::new(),
         outside_theory: c.departures,
+        events: timeline.events,
+        isolated: timeline.isolated,
     })
 }
 
