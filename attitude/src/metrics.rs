@@ -35,6 +35,25 @@ pub fn errors(x: &AgentState, l: &LeaderState, has_observer: bool) -> Errors {
     }
 }
 
+/// How far the followers are from agreeing along their edges, whatever the
+/// leader's attitude: `max |Rᵢ Rⱼᵀ|_I` over `edges` (index pairs into
+/// `agents`), 0 without edges, NaN if an attitude is not finite. It
+/// vanishes exactly when the two ends of every edge agree, i.e. each
+/// connected group of followers is synchronised among itself: what tells
+/// agents synchronised apart from the leader from agents not synchronised
+/// at all.
+#[must_use]
+pub fn spread(agents: &[AgentState], edges: &[(usize, usize)]) -> f64 {
+    edges.iter().fold(0.0, |m, &(i, j)| {
+        let e = att_err(&(agents[i].r * agents[j].r.transpose()));
+        if m.is_nan() || e.is_nan() {
+            f64::NAN
+        } else {
+            m.max(e)
+        }
+    })
+}
+
 /// `|R|_I` of a relative attitude, NaN if any entry is not finite: a
 /// diverged state has no attitude error (`abs_i` alone would clamp a NaN to 1).
 fn att_err(r: &Matrix3<f64>) -> f64 {
@@ -49,6 +68,28 @@ fn att_err(r: &Matrix3<f64>) -> f64 {
 mod tests {
     use super::*;
     use nalgebra::Vector3;
+
+    #[test]
+    fn the_spread_is_zero_iff_the_agents_agree() {
+        let x = |r: Matrix3<f64>| AgentState {
+            r,
+            w: Vector3::zeros(),
+            r_hat: r,
+            w_hat: Vector3::zeros(),
+            s_hat: Vector3::zeros(),
+        };
+        let a = crate::so3::rot(0.7, &Vector3::new(1.0, 2.0, 3.0).normalize());
+        let b = crate::so3::rot(0.3, &Vector3::z());
+        let path = [(0, 1), (1, 2)];
+        assert_eq!(spread(&[x(a), x(a), x(a)], &path), 0.0);
+        let s = spread(&[x(a), x(a), x(b * a)], &path);
+        assert!((s - abs_i(&(b * a * a.transpose()))).abs() < 1e-15, "{s}");
+        // Two groups, each agreeing, no edge between them: agreed.
+        assert_eq!(spread(&[x(a), x(a), x(b), x(b)], &[(0, 1), (2, 3)]), 0.0);
+        let nan = x(Matrix3::from_element(f64::NAN));
+        assert!(spread(&[x(a), nan], &[(0, 1)]).is_nan());
+        assert_eq!(spread(&[x(a)], &[]), 0.0);
+    }
 
     #[test]
     fn a_nan_state_has_nan_errors_never_one() {

@@ -91,7 +91,7 @@ fn writes_its_files_and_the_same_bytes_for_any_jobs() {
     assert_eq!(m["counts"]["undecided"], 6);
     assert_eq!(m["failure_rate"], 1.0);
     assert_eq!(m["failed_trials"].as_array().unwrap().len(), 6);
-    let line = format!("{:<14} {:>8}", "undecided", 6);
+    let line = format!("{:<18} {:>8}", "undecided", 6);
     assert!(out.stdout.contains(&line), "{}", out.stdout);
     // Another seed draws other initial conditions.
     mc(tmp.path(), &s, 6, "other", &["--seed", "1", "--set", SHORT]).assert_code(0);
@@ -176,7 +176,7 @@ fn converging_trials_are_counted_with_their_bound() {
         "{upper}"
     );
     assert_eq!(m["slowest"].as_array().unwrap().len(), 3);
-    let line = format!("{:<14} {:>8}", "converged", 3);
+    let line = format!("{:<18} {:>8}", "converged", 3);
     assert!(out.stdout.lines().any(|l| l == line), "{}", out.stdout);
 }
 
@@ -202,6 +202,52 @@ fn a_diverging_trial_is_classified_as_diverged() {
     assert_eq!(m["counts"]["diverging"], 2);
     let why = m["slowest"][0]["reason"].as_str().unwrap();
     assert!(why.starts_with("diverged at t = "), "{why}");
+}
+
+#[test]
+fn followers_without_a_leader_end_synchronised_apart_and_trial_k_alone_agrees() {
+    // No leader link (outside Assumption 1): each of the paper's two trees
+    // agrees within itself, neither with the leader.
+    let tmp = tempfile::tempdir().unwrap();
+    let s = paper("constant-observerless");
+    let off = [
+        "--set",
+        "leader_link=[]",
+        "--set",
+        "graph.assumptions=\"off\"",
+        "--set",
+        "simulation.duration=30",
+    ];
+    mc(tmp.path(), &s, 3, "mc", &off).assert_ok();
+    for r in trials(&tmp.path().join("mc")) {
+        assert_eq!(r[2], "synchronised-apart", "{r:?}");
+    }
+    let m = json(&tmp.path().join("mc/mc.json"));
+    assert_eq!(m["counts"]["synchronised_apart"], 3);
+    // Trial 1 alone, judged from its states.bin: the same outcome.
+    let mut args = vec!["mc", &s, "--trial", "1", "--out", "t1", "--quiet"];
+    args.extend_from_slice(&off);
+    let alone = attsync(tmp.path(), &args);
+    alone.assert_code(0);
+    let row = trials(&tmp.path().join("mc"))[1].join(",");
+    assert!(row.contains(",synchronised-apart,"), "{row}");
+    assert!(
+        alone.stdout.lines().any(|l| l == row),
+        "row 1 {row}\n{}",
+        alone.stdout
+    );
+    // With its leader links, the same draws converge to the leader.
+    mc(
+        tmp.path(),
+        &s,
+        3,
+        "led",
+        &["--set", "simulation.duration=30"],
+    )
+    .assert_ok();
+    for r in trials(&tmp.path().join("led")) {
+        assert_eq!(r[2], "converged", "{r:?}");
+    }
 }
 
 #[test]

@@ -16,7 +16,6 @@ use crate::options::OptionError;
 use crate::pool::Flow;
 use crate::processes::capacity::{self, Host, Need};
 use crate::results::layout;
-use crate::results::nan_max;
 use crate::results::staging::Staging;
 use crate::run::{Engine, RunOptions};
 use crate::scenario::{ScenarioError, input};
@@ -306,24 +305,26 @@ pub fn trial_alone(
     })
 }
 
-/// The trace of a run from its `errors.csv` (the same numbers a trial records).
+/// The trace of a run from its `states.bin` (the numbers a trial records).
 fn trace_of_run(out: &Path, base: &Base) -> Result<Trace, McError> {
-    let file = crate::results::RunLayout::new(out).errors_csv();
-    let text = std::fs::read_to_string(&file).map_err(io_at(&file))?;
+    let file = crate::results::RunLayout::new(out).states();
+    let records = crate::results::states::open(&file)?;
     let net = &base.loaded.resolved.network;
-    let mut trace = Trace::new(net.dt, false);
-    let n = net.agents.len();
-    let rows: Vec<Vec<&str>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
-    for sample in rows.chunks(n) {
-        let num = |r: &[&str], c: usize| r[c].parse::<f64>().unwrap_or(f64::NAN);
-        let t = num(&sample[0], 0);
-        let att = sample.iter().map(|r| num(r, 2)).fold(0.0, nan_max);
-        let angvel = sample.iter().map(|r| num(r, 3)).fold(0.0, nan_max);
-        trace.push(t, att, angvel);
+    let mut trace = Trace::new(net, false);
+    let mut agents = Vec::with_capacity(net.agents.len());
+    for rec in records {
+        let rec = rec?;
+        agents.clear();
+        agents.extend(
+            rec.agents
+                .iter()
+                .map(crate::results::states::AgentRecord::state),
+        );
+        trace.record(&attitude::engine::Snapshot {
+            step: rec.step,
+            leader: &rec.leader.state(),
+            agents: &agents,
+        });
     }
     Ok(trace)
 }

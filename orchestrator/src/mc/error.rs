@@ -39,6 +39,10 @@ pub enum McError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// `--trial K`: the trial's `states.bin` cannot be read back (the
+    /// message names the file).
+    #[error(transparent)]
+    States(#[from] crate::results::states::StatesError),
     /// Drawing `mc.svg` failed.
     #[error("{}: cannot draw plot: {message}", path.display())]
     Plot {

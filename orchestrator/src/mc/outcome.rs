@@ -7,7 +7,8 @@ use crate::failure::Failure;
 use crate::results::summary::Settle;
 use crate::run::Judging;
 use attitude::engine::Snapshot;
-use attitude::metrics::errors;
+use attitude::metrics::{errors, spread};
+use attitude::network::Network;
 use attsync_verdict::Kind;
 use serde::Serialize;
 
@@ -19,7 +20,12 @@ pub enum Outcome {
     Converged,
     /// It decays, but is not below the tolerance by the end (not a failure).
     Converging,
-    /// Bounded and not decaying above the tolerance (an offset or an oscillation).
+    /// The error to the leader persists, but the followers agree along
+    /// every edge: synchronised among themselves, not to the leader (their
+    /// spread, `attitude::metrics::spread`, converges or decays).
+    Synchronised,
+    /// Bounded and not decaying above the tolerance (an offset or an
+    /// oscillation), the followers not synchronised among themselves either.
     Persistent,
     /// Growing, or a state left the envelope (`[guard]`, `attitude::guard`).
     Diverging,
@@ -36,6 +42,7 @@ impl Outcome {
         match self {
             Outcome::Converged => "converged",
             Outcome::Converging => "converging",
+            Outcome::Synchronised => "synchronised-apart",
             Outcome::Persistent => "persistent",
             Outcome::Diverging => "diverging",
             Outcome::Undecided => "undecided",
@@ -63,9 +70,10 @@ impl Outcome {
     }
 
     /// Every outcome, in the order of the summary table.
-    pub const ALL: [Outcome; 6] = [
+    pub const ALL: [Outcome; 7] = [
         Outcome::Converged,
         Outcome::Converging,
+        Outcome::Synchronised,
         Outcome::Persistent,
         Outcome::Diverging,
         Outcome::Undecided,
@@ -93,6 +101,11 @@ pub struct Trace {
     pub att: Vec<f64>,
     /// The largest `‖ωᵢ − ω₀‖` over agents at each sample, rad/s.
     pub angvel: Vec<f64>,
+    /// How far the followers are from agreeing along their edges at each
+    /// sample (`attitude::metrics::spread`).
+    pub spread: Vec<f64>,
+    /// The follower edges (index pairs into the agents).
+    edges: Vec<(usize, usize)>,
     dt: f64,
     has_observer: bool,
 }
@@ -100,12 +113,18 @@ pub struct Trace {
 use crate::results::nan_max;
 
 impl Trace {
-    /// An empty trace for a network with step `dt`.
+    /// An empty trace for a run of `net`.
     #[must_use]
-    pub fn new(dt: f64, has_observer: bool) -> Self {
+    pub fn new(net: &Network, has_observer: bool) -> Self {
+        let mut edges: Vec<(usize, usize)> = (net.neighbour_indices().iter().enumerate())
+            .flat_map(|(i, nbrs)| nbrs.iter().map(move |&j| (i.min(j), i.max(j))))
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
         Self {
-            dt,
+            dt: net.dt,
             has_observer,
+            edges,
             ..Self::default()
         }
     }
@@ -118,15 +137,17 @@ impl Trace {
             att = nan_max(att, e.att);
             angvel = nan_max(angvel, e.angvel);
         }
-        self.push(crate::results::sample_time(snap.step, self.dt), att, angvel);
+        let t = crate::results::sample_time(snap.step, self.dt);
+        self.push(t, [att, angvel, spread(snap.agents, &self.edges)]);
     }
 
     /// Appends a sample at time `t` whose largest errors over agents are
-    /// `att` and `angvel`.
-    pub fn push(&mut self, t: f64, att: f64, angvel: f64) {
+    /// `att` and `angvel`, the followers' spread `spread`.
+    pub fn push(&mut self, t: f64, [att, angvel, spread]: [f64; 3]) {
         self.t.push(t);
         self.att.push(att);
         self.angvel.push(angvel);
+        self.spread.push(spread);
     }
 
     /// Forgets every sample (a run started again with a longer horizon).
@@ -134,17 +155,35 @@ impl Trace {
         self.t.clear();
         self.att.clear();
         self.angvel.clear();
+        self.spread.clear();
     }
 
     /// The verdict on the attitude errors recorded so far.
     #[must_use]
     pub fn verdict(&self, judging: &Judging) -> attsync_verdict::Verdict {
-        attsync_verdict::classify(
-            &self.t,
-            &self.att,
-            judging.tolerance,
-            &attsync_verdict::Thresholds::default(),
-        )
+        Self::judge(&self.t, &self.att, judging)
+    }
+
+    /// The outcome of a complete run: the attitude errors' verdict, and
+    /// for a persistent error, whether the followers' spread decays
+    /// ([`Outcome::Synchronised`]).
+    #[must_use]
+    pub fn outcome(&self, v: &attsync_verdict::Verdict, judging: &Judging) -> Outcome {
+        let apart = v.kind == Kind::Persistent
+            && matches!(
+                Self::judge(&self.t, &self.spread, judging).kind,
+                Kind::Converged | Kind::Converging
+            );
+        if apart {
+            Outcome::Synchronised
+        } else {
+            Outcome::of(v.kind)
+        }
+    }
+
+    fn judge(t: &[f64], e: &[f64], judging: &Judging) -> attsync_verdict::Verdict {
+        let thresholds = attsync_verdict::Thresholds::default();
+        attsync_verdict::classify(t, e, judging.tolerance, &thresholds)
     }
 }
 
@@ -186,7 +225,7 @@ pub fn classify(trial: u64, seed: u64, end: End, trace: &Trace, judging: &Judgin
     let (verdict, outcome, reason) = match end {
         End::Complete => {
             let v = trace.verdict(judging);
-            let o = Outcome::of(v.kind);
+            let o = trace.outcome(&v, judging);
             (Some(v), o, None)
         }
         End::Diverged(t, why) => (
@@ -224,9 +263,34 @@ mod tests {
             t: (0..att.len()).map(|k| k as f64 * dt).collect(),
             att: att.to_vec(),
             angvel: angvel.to_vec(),
+            spread: att.to_vec(),
+            edges: Vec::new(),
             dt,
             has_observer: false,
         }
+    }
+
+    #[test]
+    fn followers_that_agree_apart_from_the_leader_are_synchronised_apart() {
+        let stall = vec![0.5; 400];
+        let agree = decay(1.0, -1.0, 400);
+        let apart = Trace {
+            spread: agree.clone(),
+            ..trace(&stall, &stall, 0.1)
+        };
+        let r = classify(0, 9, End::Complete, &apart, &judging());
+        assert_eq!(r.outcome, Outcome::Synchronised);
+        assert!(r.outcome.is_failure());
+        // Not agreeing either: persistent.
+        let r = classify(1, 9, End::Complete, &trace(&stall, &stall, 0.1), &judging());
+        assert_eq!(r.outcome, Outcome::Persistent);
+        // Converged to the leader: the spread is not looked at.
+        let done = Trace {
+            spread: stall.clone(),
+            ..trace(&agree, &agree, 0.1)
+        };
+        let r = classify(2, 9, End::Complete, &done, &judging());
+        assert_eq!(r.outcome, Outcome::Converged);
     }
 
     fn judging() -> Judging {

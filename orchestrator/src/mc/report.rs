@@ -115,6 +115,8 @@ pub struct Counts {
     pub converged: u64,
     /// Converging (decaying, not below the tolerance by the end).
     pub converging: u64,
+    /// Synchronised among themselves, not to the leader.
+    pub synchronised_apart: u64,
     /// Persistent.
     pub persistent: u64,
     /// Diverging (growing, or a state left the envelope).
@@ -140,6 +142,7 @@ impl Counts {
         match o {
             Outcome::Converged => &mut self.converged,
             Outcome::Converging => &mut self.converging,
+            Outcome::Synchronised => &mut self.synchronised_apart,
             Outcome::Persistent => &mut self.persistent,
             Outcome::Diverging => &mut self.diverging,
             Outcome::Undecided => &mut self.undecided,
@@ -153,6 +156,7 @@ impl Counts {
         match o {
             Outcome::Converged => self.converged,
             Outcome::Converging => self.converging,
+            Outcome::Synchronised => self.synchronised_apart,
             Outcome::Persistent => self.persistent,
             Outcome::Diverging => self.diverging,
             Outcome::Undecided => self.undecided,
@@ -284,9 +288,9 @@ pub fn table(s: &McSummary, results: &[TrialResult]) -> String {
         )),
         s.tolerance
     );
-    let _ = writeln!(t, "{:<14} {:>8}", "outcome", "trials");
+    let _ = writeln!(t, "{:<18} {:>8}", "outcome", "trials");
     for o in Outcome::ALL {
-        let _ = writeln!(t, "{:<14} {:>8}", o.name(), s.counts.get(o));
+        let _ = writeln!(t, "{:<18} {:>8}", o.name(), s.counts.get(o));
     }
     let [lo, hi] = s.failure_rate_interval_95;
     let _ = writeln!(

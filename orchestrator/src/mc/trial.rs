@@ -129,7 +129,7 @@ fn has_observer(p: &Prepared) -> bool {
 #[must_use]
 pub fn run_in_process(p: &Prepared, judging: &Judging, interrupt: &Interrupt) -> Ran {
     let net = &p.loaded.resolved.network;
-    let mut trace = Trace::new(net.dt, has_observer(p));
+    let mut trace = Trace::new(net, has_observer(p));
     let mut engine = InProcess::new(net);
     let max = judging.max_steps(net.steps, net.dt);
     let mut stopped = false;
@@ -177,7 +177,7 @@ pub fn run_processes(
 ) -> Result<Ran, ProcessError> {
     let mut net = p.loaded.resolved.network.clone();
     let max = judging.max_steps(net.steps, net.dt);
-    let mut trace = Trace::new(net.dt, has_observer(p));
+    let mut trace = Trace::new(&net, has_observer(p));
     let mut opts = opts.clone();
     opts.plugins = p.loaded.resolved.plugins.clone();
     // Without plug-ins the in-process engine finds the final horizon
