@@ -251,6 +251,40 @@ fn followers_without_a_leader_end_synchronised_apart_and_trial_k_alone_agrees() 
 }
 
 #[test]
+fn a_ring_without_a_leader_ends_synchronised_or_twisted_whatever_the_horizon() {
+    let tmp = tempfile::tempdir().unwrap();
+    let ring = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../scenarios/experiments/ring.toml"
+    );
+    let outcomes = |out: &str, duration: &str| {
+        let set = format!("simulation.duration={duration}");
+        mc(
+            tmp.path(),
+            ring,
+            40,
+            out,
+            &["--until", "settled", "--set", &set],
+        )
+        .assert_ok();
+        let rows = trials(&tmp.path().join(out));
+        rows.iter().map(|r| r[2].clone()).collect::<Vec<_>>()
+    };
+    let short = outcomes("short", "60");
+    let count = |o: &str| short.iter().filter(|x| *x == o).count();
+    assert!(
+        count("persistent") > 0 && count("synchronised-apart") > 0,
+        "{short:?}"
+    );
+    assert_eq!(
+        count("persistent") + count("synchronised-apart"),
+        40,
+        "{short:?}"
+    );
+    assert_eq!(short, outcomes("long", "200"));
+}
+
+#[test]
 fn the_monte_carlo_table_is_validated() {
     let tmp = tempfile::tempdir().unwrap();
     let s = paper("constant-observerless");

@@ -164,21 +164,29 @@ impl Trace {
         Self::judge(&self.t, &self.att, judging)
     }
 
-    /// The outcome of a complete run: the attitude errors' verdict, and
-    /// for a persistent error, whether the followers' spread decays
-    /// ([`Outcome::Synchronised`]).
+    /// The outcome of a complete run whose attitude errors' verdict is
+    /// `v`; for a persistent error, the followers' spread decides: below
+    /// the tolerance and staying ([`Outcome::Synchronised`]), still
+    /// decaying or too short to tell ([`Outcome::Undecided`]: a decay may
+    /// end in a twisted state, so only `--until settled` or a longer run
+    /// tells), or not ([`Outcome::Persistent`]).
     #[must_use]
     pub fn outcome(&self, v: &attsync_verdict::Verdict, judging: &Judging) -> Outcome {
-        let apart = v.kind == Kind::Persistent
-            && matches!(
-                Self::judge(&self.t, &self.spread, judging).kind,
-                Kind::Converged | Kind::Converging
-            );
-        if apart {
-            Outcome::Synchronised
-        } else {
-            Outcome::of(v.kind)
+        if v.kind != Kind::Persistent {
+            return Outcome::of(v.kind);
         }
+        match Self::judge(&self.t, &self.spread, judging).kind {
+            Kind::Converged => Outcome::Synchronised,
+            Kind::Converging | Kind::Undecided => Outcome::Undecided,
+            Kind::Persistent | Kind::Diverging => Outcome::Persistent,
+        }
+    }
+
+    /// Whether `--until settled` runs on: the outcome so far is not final.
+    #[must_use]
+    pub fn goes_on(&self, judging: &Judging) -> bool {
+        let o = self.outcome(&self.verdict(judging), judging);
+        matches!(o, Outcome::Converging | Outcome::Undecided)
     }
 
     fn judge(t: &[f64], e: &[f64], judging: &Judging) -> attsync_verdict::Verdict {
@@ -284,6 +292,17 @@ mod tests {
         // Not agreeing either: persistent.
         let r = classify(1, 9, End::Complete, &trace(&stall, &stall, 0.1), &judging());
         assert_eq!(r.outcome, Outcome::Persistent);
+        // Still decaying (it may yet stop in a twisted state): undecided,
+        // and --until settled goes on.
+        let slow = Trace {
+            spread: decay(1.0, -0.05, 400),
+            ..trace(&stall, &stall, 0.1)
+        };
+        assert_eq!(
+            classify(3, 9, End::Complete, &slow, &judging()).outcome,
+            Outcome::Undecided
+        );
+        assert!(slow.goes_on(&judging()) && !apart.goes_on(&judging()));
         // Converged to the leader: the spread is not looked at.
         let done = Trace {
             spread: stall.clone(),

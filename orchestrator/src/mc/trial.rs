@@ -143,7 +143,7 @@ pub fn run_in_process(p: &Prepared, judging: &Judging, interrupt: &Interrupt) ->
         };
         let diverged = engine.run_until(|_, _, _| (), on_sample, || interrupt.is_set());
         let ended = stopped || diverged.is_some() || engine.step_index() < engine.horizon();
-        if ended || !until::goes_on(trace.verdict(judging).kind) || engine.horizon() >= max {
+        if ended || !trace.goes_on(judging) || engine.horizon() >= max {
             break diverged;
         }
         engine.extend_to(until::next_horizon(engine.horizon(), max, net.sample_every));
@@ -201,8 +201,7 @@ pub fn run_processes(
             (None, Some(why)) => End::Failed(why),
             (None, None) => End::Complete,
         };
-        let again =
-            end == End::Complete && until::goes_on(trace.verdict(judging).kind) && net.steps < max;
+        let again = end == End::Complete && trace.goes_on(judging) && net.steps < max;
         if !again {
             return Ok(Ran::Done(p.classify(end, &trace, judging)));
         }
