@@ -24,7 +24,8 @@ use crate::timeline::{Absent, Due};
 use crate::verdict::Verdicts;
 use nalgebra::{Matrix3, Vector3};
 
-/// The closed-loop vector field of agent i and the torque it applies.
+/// The closed-loop vector field of agent i and the torque it applies
+/// (the law's, saturated as `model.effects` says: [`crate::actuator`]).
 ///
 /// Scheme 1: eqs. `followeri`, `7a`–`7c`, `control`. Scheme 2: eqs.
 /// `followeri`, `16a`–`16b`, `controlconstantestimate`. Scheme 3: eqs.
@@ -71,6 +72,10 @@ pub fn agent_field(
             let tau = tau_districontrol(control, &x.r, &x.w, gains, nbrs, leader);
             (Vector3::zeros(), Vector3::zeros(), tau)
         }
+    };
+    let tau = match model.effects.as_deref().and_then(|e| e.saturation.as_ref()) {
+        None => tau,
+        Some(s) => s.apply(&tau),
     };
     let r_hat_w = if model.scheme.has_observer() {
         r_hat_rate(&own)
@@ -154,7 +159,6 @@ pub struct Agent {
     /// `step`'s current stage state, computed once per stage (published
     /// and evaluated at).
     stage_x: AgentState,
-    dt: f64,
     held_nbrs: Vec<Exchanged>,
     /// The leader's value, for an agent that hears it (boxed: most agents
     /// do not, and the agents' data is swept at every stage).
@@ -234,7 +238,6 @@ impl Agent {
             state: initial,
             step: Stages::new(&[initial.w, initial.w_hat, initial.s_hat], dt),
             stage_x: initial,
-            dt,
             held_nbrs,
             held_leader,
             links,
@@ -475,12 +478,10 @@ impl Agent {
     /// this stage ([`Link::value_at`]).
     fn update_links(&mut self) {
         let stage = self.step.stage() as u32;
+        let dt = self.step.h();
         let n_nbrs = self.held_nbrs.len();
         for (k, link) in self.links.iter_mut().enumerate() {
-            if let Some(x) = link
-                .as_mut()
-                .and_then(|l| l.value_at(self.n, stage, self.dt))
-            {
+            if let Some(x) = link.as_mut().and_then(|l| l.value_at(self.n, stage, dt)) {
                 if k < n_nbrs {
                     self.held_nbrs[k] = x;
                 } else if let Some(h) = &mut self.held_leader {

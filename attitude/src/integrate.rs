@@ -167,6 +167,12 @@ impl<const NR: usize, const NV: usize> Stages<NR, NV> {
         self.stage
     }
 
+    /// The step size `h`.
+    #[must_use]
+    pub fn h(&self) -> f64 {
+        self.h
+    }
+
     /// The Lie-algebra increments `u` of the current stage, one per
     /// rotation: the stage point's rotations are `R₀ exp(u)` (zero at stage 0).
     #[must_use]

@@ -16,6 +16,8 @@
 //! - [`control`]: eqs. `control` (corrected `sigmai`, `gammai`),
 //!   `controlconstantestimate`, `districontrol`; the printed `sigmai`,
 //!   `gammai` as a negative control ([`control::ControlLaw`]).
+//! - [`actuator`]: actuator limits (the torque a body can apply);
+//!   [`effects`]: a body's non-ideal effects, grouped.
 //! - [`network`]: the resolved network every engine runs.
 //! - [`link`]: delay, jitter, loss and per-link period, on the receiving side.
 //! - [`timeline`]: events in steps: link outages, retunes, repoints.
@@ -31,10 +33,12 @@
 //! - [`linear`]: the closed loop linearised with communication delays: rightmost characteristic roots, exact delay margin.
 //! - [`sparse`]: sparse symmetric `LDLᵀ` / block Cholesky in a minimum-degree order (no fill-in on a forest).
 
+pub mod actuator;
 pub mod agent;
 pub mod body;
 pub mod checks;
 pub mod control;
+pub mod effects;
 pub mod engine;
 pub mod guard;
 pub mod integrate;

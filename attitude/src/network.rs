@@ -188,6 +188,10 @@ pub struct AgentModel {
     /// boxed: the agents' models are swept at every stage).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub timeline: Option<Box<AgentTimeline>>,
+    /// What makes the body non-ideal: actuator limits (`None`, and then not
+    /// written, for an ideal body; boxed like `timeline`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub effects: Option<Box<crate::effects::Effects>>,
 }
 
 /// How often neighbours exchange states.

@@ -65,6 +65,7 @@ fn chain(n: u32, dt: f64, steps: u64, coupling: Coupling) -> Network {
                 p,
                 law: Default::default(),
                 timeline: Default::default(),
+                effects: None,
             };
             let r = rot(0.5 + 0.7 * f64::from(id), &axis);
             let initial = AgentState {

@@ -543,6 +543,7 @@ fn network(observerless: bool, links: Links, steps: u64) -> Network {
                 p,
                 law: Default::default(),
                 timeline: Default::default(),
+                effects: None,
             },
             initial: AgentState {
                 r,

@@ -62,6 +62,7 @@ fn chain(n: u32, scheme: Scheme, dt: f64) -> (Leader, Vec<Agent>) {
                 p,
                 law: Default::default(),
                 timeline: Default::default(),
+                effects: None,
             };
             let r = rot(0.5 + 0.7 * f64::from(id), &axis);
             let initial = AgentState {

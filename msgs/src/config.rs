@@ -229,6 +229,7 @@ mod tests {
             p: Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.0, -0.7, 0.0, 0.7, 0.0),
             law,
             timeline: Default::default(),
+            effects: None,
         };
         let r = attitude::so3::rot(std::f64::consts::PI / 7.0, &Vector3::new(0.6, 0.8, 0.0));
         NodeConfig {

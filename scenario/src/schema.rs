@@ -35,6 +35,9 @@ pub struct Scenario {
     /// Communication impairments (default: an ideal network).
     #[serde(default)]
     pub network: NetworkSpec,
+    /// `[actuator]`: every agent's actuator limits (default: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub actuator: Option<ActuatorSpec>,
     /// `[graph]`: whether the paper's Assumption 1 is enforced.
     #[serde(default, skip_serializing_if = "GraphSpec::is_default")]
     pub graph: GraphSpec,
@@ -326,6 +329,31 @@ pub struct AgentSpec {
     /// Extra environment variables of the plug-in.
     #[serde(default)]
     pub env: Option<std::collections::BTreeMap<String, String>>,
+    /// This agent's actuator limits (in place of `[actuator]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub actuator: Option<ActuatorSpec>,
+}
+
+/// `[actuator]` or `agent.actuator`: the torque a body can apply.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorSpec {
+    /// N·m: one number, the largest `‖τ‖` (norm saturation), or three,
+    /// the largest `|τ_k|` per body axis (per-axis saturation).
+    pub max_torque: TorqueLimit,
+}
+
+/// `max_torque = 0.5` or `max_torque = [0.2, 0.3, 0.2]`.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a number (the largest ‖τ‖, N·m) or 3 numbers (the largest |τ_k| per body axis)"
+)]
+pub enum TorqueLimit {
+    /// The largest norm.
+    Norm(f64),
+    /// The largest magnitude per axis.
+    Axes([f64; 3]),
 }
 
 /// `agent.observer`.

@@ -45,9 +45,21 @@ class Agent:
         self.rk = m.Rkmk4(rots, vecs, float(cfg["dt"]))
         self.peak_torque = 0.0
         self.point = None
+        # § 10.11: the limits of the torque the body receives.
+        self.saturation = (model.get("effects") or {}).get("saturation")
         # § 10.10: gains from a step on; inputs left out of the law now.
         self.retunes = model.get("timeline", {}).get("retune", [])
         self.absent = [False] * len(self.inputs)
+
+    def saturate(self, tau):
+        """§ 10.11: the torque the body receives."""
+        sat = self.saturation
+        if sat is None:
+            return tau
+        if sat["kind"] == "norm":
+            n, mx = m.norm(tau), float(sat["max"])
+            return m.scale(tau, mx / n) if n > mx else tau
+        return tuple(mx if t > mx else -mx if t < -mx else t for t, mx in zip(tau, sat["max"]))
 
     def step_start(self, n, absent):
         """§ 10.10 at the start of step n: the last retune due by n, and the
@@ -104,6 +116,7 @@ class Agent:
         else:
             wh_dot, sh_dot = m.Z3, m.Z3
             tau = m.control_observerless(self.control, r, w, leader, neighbours)
+        tau = self.saturate(tau)
         w_dot = m.mv(self.j_inv, m.sub(tau, m.cross(w, m.mv(self.j, w))))
         omegas = [w, m.Z3 if self.scheme == "observerless" else wh]
         if s == 0:

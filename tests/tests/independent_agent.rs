@@ -149,6 +149,21 @@ fn a_timeline_of_events_is_bit_identical() {
 }
 
 #[test]
+fn actuator_limits_are_bit_identical() {
+    // PROTOCOL.md § 10.11: agent 1 saturated by norm, agent 3 per axis.
+    assert_bit_identical(
+        "independent-actuator",
+        &paper("timevarying"),
+        &[0, 2],
+        &[
+            DURATION,
+            "actuator={max_torque=0.5}",
+            "agent[2].actuator={max_torque=[0.2, 0.3, 0.25]}",
+        ],
+    );
+}
+
+#[test]
 fn the_independent_agent_conforms() {
     let tmp = Sandbox::new("independent-conform");
     let r = conform_python(&tmp, &[], &agent_py());

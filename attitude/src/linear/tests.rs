@@ -159,6 +159,7 @@ pub(super) fn agent(
             p: Matrix3::zeros(),
             law: Default::default(),
             timeline: Default::default(),
+            effects: None,
         },
         initial: AgentState {
             r: Matrix3::identity(),

@@ -105,6 +105,7 @@ pub fn network(n: u32, scheme: SchemeArg, steps: u64) -> Network {
                 p,
                 law: Default::default(),
                 timeline: Default::default(),
+                effects: None,
             };
             let r = rot(0.1 + 0.01 * k, &axis);
             let initial = AgentState {

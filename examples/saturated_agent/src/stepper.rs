@@ -231,6 +231,7 @@ mod tests {
             p: Matrix3::zeros(),
             law: Default::default(),
             timeline: Default::default(),
+            effects: None,
         };
         let initial = AgentState {
             r: rot(0.3 * std::f64::consts::PI, &u2),

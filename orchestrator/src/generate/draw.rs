@@ -42,6 +42,7 @@ pub(super) fn random_agent(rng: &mut ChaCha8Rng, id: u32, scheme: SchemeKind) ->
         observer,
         command: None,
         env: None,
+        actuator: None,
     }
 }
 

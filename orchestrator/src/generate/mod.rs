@@ -185,6 +185,7 @@ fn draw_tree(p: &TreeParams) -> Scenario {
         agents,
         edges,
         network: Default::default(),
+        actuator: None,
         graph: Default::default(),
         guard: Default::default(),
         monte_carlo: None,

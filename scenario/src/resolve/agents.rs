@@ -3,7 +3,8 @@
 use super::ctx::Ctx;
 use super::ids::Ids;
 use super::kind_name;
-use crate::schema::{AgentSpec, ObserverInit, SchemeKind};
+use crate::schema::{ActuatorSpec, AgentSpec, ObserverInit, SchemeKind, TorqueLimit};
+use attitude::actuator::Saturation;
 use attitude::body::Inertia;
 use attitude::network::AgentState;
 use nalgebra::{Matrix3, Vector3};
@@ -143,4 +144,45 @@ fn observer(
         (None, _) => Vector3::zeros(),
     };
     rh.map(|rh| (rh, wh, sh))
+}
+
+/// Every agent's actuator limits, by rank of its id: its own
+/// `agent.actuator`, else `[actuator]`, else none.
+pub(super) fn actuators(
+    c: &mut Ctx,
+    all: Option<&ActuatorSpec>,
+    agents: &[AgentSpec],
+    ids: &Ids,
+) -> Vec<Option<Saturation>> {
+    let every = all.and_then(|a| saturation(c, "actuator.max_torque", a));
+    let mut out = vec![every; ids.len()];
+    for (k, a) in agents.iter().enumerate() {
+        let own = a.actuator.as_ref();
+        let own =
+            own.and_then(|x| saturation(c, format_args!("agent[{k}].actuator.max_torque"), x));
+        if let (Some(s), Some(r)) = (own, ids.rank(a.id)) {
+            out[r] = Some(s);
+        }
+    }
+    out
+}
+
+/// The limits of `a` (at field `f`), or `None` (with an error) unless every
+/// bound is finite and > 0.
+fn saturation(c: &mut Ctx, f: impl Display + Copy, a: &ActuatorSpec) -> Option<Saturation> {
+    let bounds: &[f64] = match &a.max_torque {
+        TorqueLimit::Norm(m) => std::slice::from_ref(m),
+        TorqueLimit::Axes(m) => m,
+    };
+    if let Some(bad) = bounds.iter().find(|m| !(m.is_finite() && **m > 0.0)) {
+        c.err(
+            f.to_string(),
+            format!("a torque bound must be finite and > 0 N·m, got {bad}"),
+        );
+        return None;
+    }
+    Some(match a.max_torque {
+        TorqueLimit::Norm(max) => Saturation::Norm { max },
+        TorqueLimit::Axes(max) => Saturation::Axes { max },
+    })
 }

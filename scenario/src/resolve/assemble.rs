@@ -6,7 +6,9 @@ use super::graph::{Adjacency, Edges, LeaderLinks};
 use super::ids::Ids;
 use super::leader::Leader;
 use super::simulation::Timing;
+use attitude::actuator::Saturation;
 use attitude::control::ControlLaw;
+use attitude::effects::Effects;
 use attitude::guard::Envelope;
 use attitude::link::LinkModel;
 use attitude::network::{AgentModel, AgentSpec, Neighbour, Network, Scheme};
@@ -24,6 +26,8 @@ pub(super) struct Parts {
     pub(super) impaired: BTreeMap<(u32, u32), LinkModel>,
     pub(super) guard: Envelope,
     pub(super) law: ControlLaw,
+    /// Actuator limits, by rank of the agents' ids.
+    pub(super) actuators: Vec<Option<Saturation>>,
     pub(super) timeline: Timed,
 }
 
@@ -77,6 +81,7 @@ pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
         impaired,
         guard,
         law,
+        actuators,
         timeline,
     } = parts;
     let scheme = scheme.expect("no errors");
@@ -92,6 +97,7 @@ pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
             AgentSpec {
                 model: AgentModel {
                     timeline: timeline.of(id, inputs),
+                    effects: effects(actuators[r]),
                     id,
                     inertia,
                     a_bar,
@@ -152,4 +158,10 @@ fn neighbours(
     }));
     neighbours.sort_by_key(|n| n.id);
     neighbours
+}
+
+/// An agent's non-ideal effects, `None` for an ideal body.
+fn effects(saturation: Option<Saturation>) -> Option<Box<Effects>> {
+    let e = Effects { saturation };
+    (!e.is_ideal()).then(|| Box::new(e))
 }

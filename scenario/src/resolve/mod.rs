@@ -122,6 +122,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     let leader = leader::leader(&mut c, &s.leader, kind);
     let ids = agents::ids(&mut c, &s.agents);
     let bodies = agents::bodies(&mut c, &s.agents, kind, &ids);
+    let actuators = agents::actuators(&mut c, s.actuator.as_ref(), &s.agents, &ids);
     let edges = graph::edges(&mut c, &s.edges, &ids);
     let links = graph::leader_links(&mut c, &s.leader_links, &ids);
     let ranked = edges.ranks(&ids);
@@ -159,6 +160,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         impaired,
         guard: envelope,
         law,
+        actuators,
         timeline: assemble::Timed {
             down: timeline.down,
             retune: timeline.retune,
