@@ -316,6 +316,11 @@ fn bad_events_are_refused_naming_the_event() {
             "only a constant reference",
         ),
         (
+            "empty-set",
+            "[[event]]\nt = 1.0\nset = {}\n",
+            "event[0].set: sets nothing",
+        ),
+        (
             "crash",
             "[[event]]\nt = 1.0\nagent = 2\naction = \"crash\"\n",
             "\"crash\" is not implemented yet",

@@ -260,7 +260,17 @@ fn one_action(c: &mut Ctx, k: usize, e: &EventSpec) -> bool {
         c.err(format!("{f}.action"), format!("{name:?} is not implemented yet (cut, restore, silence, resume and set are); silence and resume model an agent that stops and starts talking"));
         return false;
     }
-    e.set.as_ref().is_none_or(|s| !s.is_empty()) && (e.agent.is_none() || e.action.is_some())
+    if e.set
+        .as_ref()
+        .is_some_and(|s| SetValue::flatten(s).is_empty())
+    {
+        c.err(
+            format!("{f}.set"),
+            "sets nothing: give at least one FIELD = value",
+        );
+        return false;
+    }
+    e.agent.is_none() || e.action.is_some()
 }
 
 /// The events in time order, with what is down so far.
