@@ -32,12 +32,14 @@ pub(super) struct Parts {
 }
 
 /// What the events do, in steps.
+#[derive(Debug, Default)]
 pub(super) struct Timed {
-    /// Outages by directed link (sender, receiver).
+    /// Outages by directed link (sender, receiver): of one mode disjoint,
+    /// ascending.
     pub(super) down: BTreeMap<(u32, u32), Vec<Outage>>,
-    /// The same for every agent.
+    /// Scheme gains from a step on, ascending; the same for every agent.
     pub(super) retune: Vec<Retune>,
-    /// The leader's.
+    /// Jumps of the constant reference, ascending: the leader's.
     pub(super) repoint: Vec<Repoint>,
 }
 

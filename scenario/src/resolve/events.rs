@@ -7,6 +7,7 @@
 //! restoring what is not cut, or cutting what is, is an error naming both
 //! events.
 
+use super::assemble::Timed;
 use super::ctx::Ctx;
 use super::graph::{Edges, LeaderLinks};
 use super::ids::Ids;
@@ -118,12 +119,8 @@ pub struct Isolation {
 /// The timeline, resolved.
 #[derive(Debug, Default)]
 pub(super) struct Timeline {
-    /// Outages of each directed link (sender, receiver), disjoint, ascending.
-    pub(super) down: BTreeMap<(u32, u32), Vec<Outage>>,
-    /// Scheme gains from a step on, ascending.
-    pub(super) retune: Vec<Retune>,
-    /// Jumps of the constant reference, ascending.
-    pub(super) repoint: Vec<Repoint>,
+    /// What the model runs: outages by directed link, retunes, repoints.
+    pub(super) timed: Timed,
     /// The events, in time order.
     pub(super) events: Vec<Event>,
     /// Agents the timeline cuts off from the leader.
@@ -473,7 +470,7 @@ impl<'a, 'w> Walk<'a, 'w> {
                 return None;
             }
             let r0 = c.rotation(field, spec)?;
-            self.out.repoint.push(Repoint { step, r0 });
+            self.out.timed.repoint.push(Repoint { step, r0 });
             return Some(what(None, Some(r0.transpose().into())));
         }
         let SetValue::Number(x) = *value else {
@@ -485,14 +482,14 @@ impl<'a, 'w> Walk<'a, 'w> {
         };
         let scheme = retuned(c, field, path, self.scheme?, x)?;
         self.scheme = Some(scheme);
-        self.out.retune.push(Retune { step, scheme });
+        self.out.timed.retune.push(Retune { step, scheme });
         Some(what(Some(x), None))
     }
 
     fn down(&mut self, arcs: &[(u32, u32)], o: Outage) {
         if o.from < o.to {
             for a in arcs {
-                self.out.down.entry(*a).or_default().push(o);
+                self.out.timed.down.entry(*a).or_default().push(o);
             }
         }
     }
@@ -514,10 +511,10 @@ impl<'a, 'w> Walk<'a, 'w> {
             let arcs = self.world.arcs_out(id);
             self.down(&arcs, open(since));
         }
-        for outages in self.out.down.values_mut() {
+        for outages in self.out.timed.down.values_mut() {
             *outages = merged(std::mem::take(outages));
         }
-        self.out.isolated = isolated(self.world, &self.out.down);
+        self.out.isolated = isolated(self.world, &self.out.timed.down);
         for i in &self.out.isolated {
             let ids: Vec<String> = i.agents.iter().map(u32::to_string).collect();
             let s = if ids.len() == 1 { "" } else { "s" };

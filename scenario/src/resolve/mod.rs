@@ -161,11 +161,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         guard: envelope,
         law,
         actuators,
-        timeline: assemble::Timed {
-            down: timeline.down,
-            retune: timeline.retune,
-            repoint: timeline.repoint,
-        },
+        timeline: timeline.timed,
     };
     let incoming = edges.incoming(&ids);
     let wiring = assemble::Graph {
