@@ -83,6 +83,13 @@ impl Stepper for AgentNode {
         self.agent.peak_torque()
     }
 
+    fn torque(&self, step: u64) -> Option<Telemetry> {
+        Some(Telemetry::Torque {
+            step,
+            tau: self.agent.torque(),
+        })
+    }
+
     fn link_stats(&self) -> Vec<(u32, attitude::link::LinkStats)> {
         self.agent.link_stats()
     }

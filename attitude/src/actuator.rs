@@ -41,6 +41,39 @@ impl Saturation {
     }
 }
 
+/// A limit on how fast the applied torque changes: `‖τ(t) − τ_a‖ ≤ ρ·Δt`
+/// from the torque `τ_a` applied at the last step start (`PROTOCOL.md`
+/// § 10.11).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct RateLimit {
+    /// `ρ`, N·m/s, > 0.
+    pub max: f64,
+}
+
+/// `Δt / h` from the anchor to stage `s`: the anchor of stage 0 is the
+/// previous step's stage 0 (a whole step back), that of stages 1–3 the
+/// current step's stage 0 (`c_s` of a step back).
+const SINCE_ANCHOR: [f64; 4] = [1.0, 0.5, 0.5, 1.0];
+
+impl RateLimit {
+    /// The torque applied at stage `s` (step `h`) when `tau` is asked and
+    /// `anchor` was applied at the anchor: `anchor + (tau − anchor)·(m/n)`
+    /// when `n = ‖tau − anchor‖ > m = (ρ·h)·Δt/h`, else `tau`.
+    #[must_use]
+    pub fn apply(
+        &self,
+        tau: &Vector3<f64>,
+        anchor: &Vector3<f64>,
+        s: usize,
+        h: f64,
+    ) -> Vector3<f64> {
+        let step = tau - anchor;
+        let n = step.norm();
+        let m = (self.max * h) * SINCE_ANCHOR[s];
+        if n > m { anchor + step * (m / n) } else { *tau }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -58,5 +91,18 @@ mod tests {
         };
         assert_eq!(axes.apply(&tau), Vector3::new(1.0, -4.0, 0.0));
         assert_eq!(axes.apply(&-tau), Vector3::new(-1.0, 4.0, 0.0));
+    }
+
+    #[test]
+    fn a_rate_limit_moves_the_torque_at_most_rho_dt_from_its_anchor() {
+        let r = RateLimit { max: 10.0 };
+        let anchor = Vector3::new(1.0, 0.0, 0.0);
+        let far = Vector3::new(1.0, 5.0, 0.0);
+        let got = r.apply(&far, &anchor, 0, 0.01);
+        assert!((got - Vector3::new(1.0, 0.1, 0.0)).norm() < 1e-15);
+        let half = r.apply(&far, &anchor, 1, 0.01);
+        assert!((half - Vector3::new(1.0, 0.05, 0.0)).norm() < 1e-15);
+        let near = Vector3::new(1.0, 0.01, 0.0);
+        assert_eq!(r.apply(&near, &anchor, 3, 0.01), near);
     }
 }

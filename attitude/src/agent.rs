@@ -13,7 +13,9 @@
 
 use crate::body::omega_dot;
 use crate::control::{tau_districontrol, tracking_error};
+use crate::effects::{At, Body, EffectsState, Ideal};
 use crate::guard::{self, Envelope, Violation};
+use crate::integrate::stage_time_fraction;
 use crate::integrate::{LieDerivative, LieState, Stages, Start};
 use crate::link::{Link, LinkModel, LinkStats};
 use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
@@ -32,36 +34,43 @@ use nalgebra::{Matrix3, Vector3};
 /// `followeri`, `districontrol`. Schemes 1–2 take `Σᵢ`, `Γᵢ` as
 /// `model.law` says (corrected, or as printed: the negative control).
 /// `nbrs` are in the order of `model.neighbours`; `leader` is `Some` iff
-/// the agent hears the leader.
+/// the agent hears the leader. `body` is the body's effects at this stage
+/// ([`Ideal`] unless `model.effects` is set): the law measures `x` through
+/// its sensors and assumes `Ĵᵢ`, the body receives `sat(τᵢ) + dᵢ(t)`
+/// ([`crate::effects`]).
 #[must_use]
-pub fn agent_field(
+pub fn agent_field<B: Body>(
     model: &AgentModel,
     gains: &[Matrix3<f64>],
     x: &AgentState,
     nbrs: &[Exchanged],
     leader: Option<&Exchanged>,
+    body: &B,
 ) -> (AgentDerivative, Vector3<f64>) {
     let leader = match (leader, &model.leader_gain) {
         (Some(x), Some(a)) => Some(LeaderInput { a, x }),
         _ => None,
     };
     let own = exchanged_of(&model.scheme, x);
+    let measured = body.measure(x);
+    let m = measured.as_ref().unwrap_or(x);
+    let inertia = body.law_inertia().unwrap_or(&model.inertia);
     let (w_hat_dot, s_hat_dot, tau) = match &model.scheme {
         Scheme::ObserverTimeVarying { observer, control } => {
             let w_hat_dot = omega_hat_dot_7b(observer, &own, gains, nbrs, leader);
             let s_hat_dot = sigma_hat_dot_7c(observer, &model.p, &own, nbrs, leader);
-            let e = tracking_error(&x.r, &x.w, &x.r_hat, &x.w_hat);
+            let e = tracking_error(&m.r, &m.w, &x.r_hat, &x.w_hat);
             let tau = model
                 .law
-                .tau_control(control, &model.inertia, &model.a_bar, &e, &w_hat_dot);
+                .tau_control(control, inertia, &model.a_bar, &e, &w_hat_dot);
             (w_hat_dot, s_hat_dot, tau)
         }
         Scheme::ObserverConstant { observer, control } => {
             let w_hat_dot = omega_hat_dot_16b(observer, &own, gains, nbrs, leader);
-            let e = tracking_error(&x.r, &x.w, &x.r_hat, &x.w_hat);
+            let e = tracking_error(&m.r, &m.w, &x.r_hat, &x.w_hat);
             let tau = model.law.tau_control_constant_estimate(
                 control,
-                &model.inertia,
+                inertia,
                 &model.a_bar,
                 &e,
                 &w_hat_dot,
@@ -69,13 +78,14 @@ pub fn agent_field(
             (w_hat_dot, Vector3::zeros(), tau)
         }
         Scheme::Observerless { control } => {
-            let tau = tau_districontrol(control, &x.r, &x.w, gains, nbrs, leader);
+            let tau = tau_districontrol(control, &m.r, &m.w, gains, nbrs, leader);
             (Vector3::zeros(), Vector3::zeros(), tau)
         }
     };
-    let tau = match model.effects.as_deref().and_then(|e| e.saturation.as_ref()) {
+    let tau = body.actuate(tau);
+    let body_tau = match body.disturbance(&x.r) {
+        Some(d) => tau + d,
         None => tau,
-        Some(s) => s.apply(&tau),
     };
     let r_hat_w = if model.scheme.has_observer() {
         r_hat_rate(&own)
@@ -84,24 +94,75 @@ pub fn agent_field(
     };
     let d = LieDerivative {
         omega: [x.w, r_hat_w],
-        vec: [omega_dot(&model.inertia, &x.w, &tau), w_hat_dot, s_hat_dot],
+        vec: [
+            omega_dot(&model.inertia, &x.w, &body_tau),
+            w_hat_dot,
+            s_hat_dot,
+        ],
     };
     (d, tau)
 }
 
 /// [`agent_field`] with the inputs `absent` says are out left out of
 /// every sum (the leader: as if the agent did not hear it).
-fn without(
+fn without<B: Body>(
     model: &AgentModel,
     gains: &[Matrix3<f64>],
     x: &AgentState,
     nbrs: &[Exchanged],
     leader: Option<&Exchanged>,
     absent: &mut Absent,
+    body: &B,
 ) -> (AgentDerivative, Vector3<f64>) {
     absent.keep(gains, nbrs);
     let leader = leader.filter(|_| !absent.leader(gains.len()));
-    agent_field(model, &absent.gains, x, &absent.nbrs, leader)
+    agent_field(model, &absent.gains, x, &absent.nbrs, leader, body)
+}
+
+/// [`agent_field`] with the inputs `absent` leaves out (when any) and the
+/// body's effects `at` (an ideal body without).
+fn field(
+    (model, gains, x): (&AgentModel, &[Matrix3<f64>], &AgentState),
+    nbrs: &[Exchanged],
+    leader: Option<&Exchanged>,
+    absent: Option<&mut Absent>,
+    at: Option<&At<'_>>,
+) -> (AgentDerivative, Vector3<f64>) {
+    match (absent, at) {
+        (None, None) => agent_field(model, gains, x, nbrs, leader, &Ideal),
+        (None, Some(b)) => agent_field(model, gains, x, nbrs, leader, b),
+        (Some(a), None) => without(model, gains, x, nbrs, leader, a, &Ideal),
+        (Some(a), Some(b)) => without(model, gains, x, nbrs, leader, a, b),
+    }
+}
+
+/// The inputs left out now (when any is) and the state of the body's
+/// random effects, from an agent's timeline box.
+fn split(timed: Option<&mut Timed>) -> (Option<&mut Absent>, Option<&EffectsState>) {
+    match timed {
+        Some(t) => (t.absent.as_mut().filter(|a| a.any), t.effects.as_ref()),
+        None => (None, None),
+    }
+}
+
+/// The body's effects at stage `s` of step `n` (`None` for an ideal body).
+fn at<'a>(
+    model: &'a AgentModel,
+    state: Option<&'a EffectsState>,
+    (n, s): (u64, usize),
+    h: f64,
+    anchor: Vector3<f64>,
+) -> Option<At<'a>> {
+    let effects = model.effects.as_deref()?;
+    Some(At {
+        effects,
+        state,
+        n,
+        t: (n as f64 + stage_time_fraction(s)) * h,
+        h,
+        s,
+        anchor,
+    })
 }
 
 /// Tangent vector of an agent's state: rates of `(Rᵢ, R̂ᵢ)` and `(ωᵢ, ω̂ᵢ, σ̂ᵢ)`.
@@ -171,10 +232,12 @@ pub struct Agent {
     /// stepping: one allocation fewer touched per stage).
     impaired: bool,
     /// Values refused as untrusted, per input (neighbours, then the leader).
-    rejected: Vec<u64>,
+    rejected: Box<[u64]>,
     /// Current step index.
     n: u64,
     peak_torque: f64,
+    /// The torque applied at stage 0 of step `n` (zero before it is evaluated).
+    tau0: Vector3<f64>,
     /// What proves the verdicts of this step's published values.
     verdicts: Verdicts,
     /// What its timeline has done so far, for an agent with one (boxed:
@@ -182,7 +245,8 @@ pub struct Agent {
     timed: Option<Box<Timed>>,
 }
 
-/// The state of an agent's timeline ([`crate::timeline`]).
+/// The state of an agent's timeline ([`crate::timeline`]) and of its
+/// body's random effects ([`crate::effects`]).
 #[derive(Debug, Clone, Default)]
 struct Timed {
     /// The retunes taken so far.
@@ -190,6 +254,8 @@ struct Timed {
     /// The inputs left out of the law now, for an agent with outages that
     /// `forget`.
     absent: Option<Absent>,
+    /// What the body's noise and sensors hold this step.
+    effects: Option<EffectsState>,
 }
 
 impl Agent {
@@ -218,16 +284,18 @@ impl Agent {
         if model.leader_gain.is_some() {
             links.push(impaired(&model.leader_link, 0));
         }
-        let rejected = vec![0; links.len()];
+        let rejected = vec![0; links.len()].into_boxed_slice();
         let impaired = links.iter().any(Option::is_some);
         let forgets = links.iter().flatten().any(|l| l.ever_forgets());
-        let timed = timeline.map(|_| {
+        let effects = (model.effects.as_deref()).and_then(|e| EffectsState::new(e, dt));
+        let timed = (timeline.is_some() || effects.is_some()).then(|| {
             Box::new(Timed {
                 retuned: Due::default(),
                 absent: forgets.then(|| Absent {
                     now: vec![false; links.len()],
                     ..Absent::default()
                 }),
+                effects,
             })
         });
         let mut agent = Self {
@@ -244,11 +312,24 @@ impl Agent {
             impaired,
             n: 0,
             peak_torque: 0.0,
+            tau0: Vector3::zeros(),
             verdicts: Verdicts::default(),
         };
         agent.retune();
         agent.left_out();
+        agent.draw();
         agent
+    }
+
+    /// Draws what the body's random effects hold over the current step,
+    /// at a step's start only.
+    fn draw(&mut self) {
+        let (Some(e), Some(t)) = (self.model.effects.as_deref(), self.timed.as_deref_mut()) else {
+            return;
+        };
+        if let Some(s) = &mut t.effects {
+            s.step(e, self.n);
+        }
     }
 
     /// Which inputs the law leaves out at the current step (outages that
@@ -293,10 +374,34 @@ impl Agent {
         self.peak_torque
     }
 
+    /// The torque `τᵢ` the body received (after the actuator's limits) at
+    /// stage 0 of the current step, that is at `t = n·dt` from the state at
+    /// the step's start: valid once that stage was evaluated (after the
+    /// step's first [`Self::advance`]); zero before the first step.
+    #[must_use]
+    pub fn torque(&self) -> Vector3<f64> {
+        self.tau0
+    }
+
     /// What the agent publishes at the current stage.
     #[must_use]
     pub fn stage_exchange(&self) -> Exchanged {
-        exchanged_of(&self.model.scheme, &self.stage_x)
+        match self.sensed_stage() {
+            Some(m) => exchanged_of(&self.model.scheme, &m),
+            None => exchanged_of(&self.model.scheme, &self.stage_x),
+        }
+    }
+
+    /// The stage state as its sensors measure it, for an observerless agent
+    /// with sensors (it publishes what it measures; with an observer it
+    /// publishes the observer's state, which it knows exactly).
+    fn sensed_stage(&self) -> Option<AgentState> {
+        if self.model.scheme.has_observer() {
+            return None;
+        }
+        let state = self.timed.as_deref()?.effects.as_ref();
+        let slot = (self.n, self.step.stage());
+        at(&self.model, state, slot, self.step.h(), self.tau0)?.measure(&self.stage_x)
     }
 
     /// The guard's check of the state at the start of the current step
@@ -330,6 +435,15 @@ impl Agent {
     #[inline]
     pub(crate) fn publish_into(&mut self, out: &mut Exchanged) -> bool {
         *out = self.stage_exchange();
+        if self
+            .model
+            .effects
+            .as_ref()
+            .is_some_and(|e| e.sensor.is_some())
+        {
+            // a measured attitude is not the integrator's stage point: no proof
+            return out.trust().is_ok();
+        }
         let published = usize::from(self.model.scheme.has_observer());
         let u = &self.step.increments()[published];
         (self.verdicts).judge(out, self.n, self.step.stage(), u)
@@ -429,24 +543,11 @@ impl Agent {
     pub fn advance(&mut self) -> bool {
         self.update_links();
         let leader = self.held_leader.as_deref();
-        let absent = self.timed.as_deref_mut().and_then(|t| t.absent.as_mut());
-        let (d, tau) = match absent.filter(|a| a.any) {
-            None => agent_field(
-                &self.model,
-                &self.gains,
-                &self.stage_x,
-                &self.held_nbrs,
-                leader,
-            ),
-            Some(a) => without(
-                &self.model,
-                &self.gains,
-                &self.stage_x,
-                &self.held_nbrs,
-                leader,
-                a,
-            ),
-        };
+        let (absent, state) = split(self.timed.as_deref_mut());
+        let slot = (self.n, self.step.stage());
+        let at = at(&self.model, state, slot, self.step.h(), self.tau0);
+        let own = (&self.model, &self.gains[..], &self.stage_x);
+        let (d, tau) = field(own, &self.held_nbrs, leader, absent, at.as_ref());
         self.finish_stage(&d, &tau)
     }
 
@@ -466,11 +567,11 @@ impl Agent {
             }
         }
         let leader = self.held_leader.as_deref();
-        let absent = self.timed.as_deref_mut().and_then(|t| t.absent.as_mut());
-        let (d, tau) = match absent.filter(|a| a.any) {
-            None => agent_field(&self.model, &self.gains, &self.stage_x, nbrs, leader),
-            Some(a) => without(&self.model, &self.gains, &self.stage_x, nbrs, leader, a),
-        };
+        let (absent, state) = split(self.timed.as_deref_mut());
+        let slot = (self.n, self.step.stage());
+        let at = at(&self.model, state, slot, self.step.h(), self.tau0);
+        let own = (&self.model, &self.gains[..], &self.stage_x);
+        let (d, tau) = field(own, nbrs, leader, absent, at.as_ref());
         self.finish_stage(&d, &tau)
     }
 
@@ -496,6 +597,7 @@ impl Agent {
     fn finish_stage(&mut self, d: &AgentDerivative, tau: &Vector3<f64>) -> bool {
         if self.step.stage() == 0 {
             self.peak_torque = self.peak_torque.max(tau.norm());
+            self.tau0 = *tau;
         }
         match self.step.push_derivative(start(&self.state), d) {
             Some(next) => {
@@ -506,6 +608,7 @@ impl Agent {
                 if self.timed.is_some() {
                     self.retune();
                     self.left_out();
+                    self.draw();
                 }
                 true
             }

@@ -11,6 +11,12 @@
 //! caller's per-agent work for its own agents (recording's rows), so the
 //! serial part of a sample is only what cannot be shared (writing files).
 //!
+//! A sample of step n (t = n·dt) carries every agent's torque at stage 0
+//! of step n ([`Snapshot::torques`]), so it is handed out once that stage
+//! was evaluated: after the divergence check of the step's start state,
+//! stage 0 of step n, then the sample, then stages 1–3. The state is still
+//! the step's start state then; between samples nothing extra is done.
+//!
 //! # Layout
 //! - `pass`: one stage over a run of agents (receive, advance, publish, check).
 //! - `crew`: the parallel step (shares of agents, the exchange barrier).
@@ -29,6 +35,7 @@ use crate::reference::{Leader, LeaderState};
 use crate::schedule::{Schedule, Slot};
 use board::Judged;
 use crew::{Board, Plan, Share};
+use nalgebra::Vector3;
 use pass::{Stage, pass};
 
 /// Fewest agents per thread [`InProcess::with_threads`] gives a thread:
@@ -45,7 +52,16 @@ pub struct Snapshot<'a> {
     pub leader: &'a LeaderState,
     /// Agent states, in the order of `Network::agents`.
     pub agents: &'a [AgentState],
+    /// Every agent's torque `τᵢ` at stage 0 of step `step` (t = step·dt,
+    /// from the states above), after the actuator's limits, N·m, body
+    /// frame, in the order of `agents`: NaN at the run's last step (no
+    /// torque is applied after it) and where a node did not report it.
+    pub torques: &'a [Vector3<f64>],
 }
+
+/// The torque recorded where none was applied (after the run's last step)
+/// or none was reported.
+pub const NO_TORQUE: Vector3<f64> = Vector3::new(f64::NAN, f64::NAN, f64::NAN);
 
 /// All nodes of a network in one process.
 #[derive(Debug)]
@@ -56,9 +72,14 @@ pub struct InProcess {
     /// For each agent, the index in `agents` of each neighbour.
     nbr_index: Vec<Vec<usize>>,
     step: u64,
+    /// Whether stage 0 of step `step` was evaluated already (a sample of
+    /// it is taken after that stage; the rest of the step follows).
+    begun: bool,
     states: Vec<AgentState>,
+    /// Every agent's torque at stage 0 of the last sampled step.
+    torques: Vec<Vector3<f64>>,
     /// The step of the last snapshot `run` handed out, and each agent's
-    /// peak torque then.
+    /// peak torque then (at the step's start, before its stage 0).
     sampled: (u64, Vec<f64>),
     /// Threads [`Self::run`] uses (1: the calling thread only).
     threads: usize,
@@ -95,7 +116,9 @@ impl InProcess {
             agents,
             nbr_index,
             step: 0,
+            begun: false,
             states,
+            torques: Vec::new(),
             sampled: (0, Vec::new()),
             threads: 1,
             published: [vec![Judged::default(); n], vec![Judged::default(); n]],
@@ -156,14 +179,32 @@ impl InProcess {
         &self.agents
     }
 
-    /// The current state as a snapshot.
+    /// The current state as a snapshot; its torques are those of the last
+    /// sample (this step's right after it was sampled).
     #[must_use]
     pub fn snapshot(&self) -> Snapshot<'_> {
         Snapshot {
             step: self.step,
             leader: self.leader.state(),
             agents: &self.states,
+            torques: &self.torques,
         }
+    }
+
+    /// Evaluates stage 0 of the current step, unless it was already or the
+    /// horizon is reached, and returns every agent's torque of it
+    /// ([`Agent::torque`]; `None` at the horizon). The step goes on from
+    /// stage 1 at the next [`Self::run`] or [`Self::step`], bit-identical.
+    /// What a run extended past its horizon ([`Self::extend_to`]) uses to
+    /// complete the torques of its former last sample, which had none.
+    pub fn begin_step(&mut self) -> Option<&[Vector3<f64>]> {
+        if self.step >= self.net.steps {
+            return None;
+        }
+        self.begin_serial();
+        self.torques.clear();
+        self.torques.extend(self.agents.iter().map(Agent::torque));
+        Some(&self.torques)
     }
 
     /// Advances every node by one step (four stages, exchanging as the
@@ -173,53 +214,79 @@ impl InProcess {
         self.refresh_states();
     }
 
-    /// One step on the calling thread, one [`pass`] over the agents per
-    /// stage; returns the first agent whose new state is outside the
-    /// envelope (index, violation). Leaves `states` as it was.
+    /// One step on the calling thread (from stage 1 if stage 0 was
+    /// evaluated already), one [`pass`] over the agents per stage; returns
+    /// the first agent whose new state is outside the envelope (index,
+    /// violation). Leaves `states` as it was.
     fn advance_step(&mut self) -> Option<(usize, Violation)> {
         let schedule = Schedule::new(self.net.coupling, self.net.steps);
+        let skip = usize::from(std::mem::take(&mut self.begun));
         let mut found = None;
-        for slot in schedule.stages(self.step) {
-            let leader = slot.exchange.then(|| {
-                self.publish_if_needed(slot);
-                Judged::of(self.leader.stage_exchange())
-            });
-            self.leader.advance();
-            let next = schedule.next(slot).filter(|x| x.exchange);
-            let stage = Stage {
-                leader,
-                publish: next.is_some(),
-                check: slot.ends_step().then_some(&self.net.guard),
-            };
-            // Read this exchange's buffer; write the next exchange's (the
-            // other one at an exchange; nothing is read otherwise).
-            let [now, after] = &mut self.published;
-            let (read, out) = if slot.exchange {
-                (&*now, after)
-            } else {
-                (&*after, now)
-            };
-            found = pass(
-                &mut self.agents,
-                &self.nbr_index,
-                (stage, &mut self.scratch),
-                |j| &read[j],
-                |k, a| {
-                    let Judged(x, trusted) = &mut out[k];
-                    *trusted = a.publish_into(x);
-                    if !*trusted {
-                        *x = read[k].0;
-                    }
-                },
-            );
-            if slot.exchange {
-                self.published.swap(0, 1);
-            }
-            if let Some(x) = next {
-                self.ready = Some((x.step, x.stage));
-            }
+        for slot in schedule.stages(self.step).skip(skip) {
+            found = self.advance_stage(schedule, slot);
         }
         self.step += 1;
+        found
+    }
+
+    /// Stage 0 of the current step on the calling thread, once (see
+    /// [`Self::begin_step`]).
+    fn begin_serial(&mut self) {
+        if self.begun || self.step >= self.net.steps {
+            return;
+        }
+        let schedule = Schedule::new(self.net.coupling, self.net.steps);
+        let first = schedule
+            .stages(self.step)
+            .next()
+            .expect("a step has stages");
+        // Stage 0 does not end a step: nothing is checked against the envelope.
+        self.advance_stage(schedule, first);
+        self.begun = true;
+    }
+
+    /// One stage `slot` of `schedule` on the calling thread: the leader
+    /// and one [`pass`] over the agents; at the step's end, the first agent
+    /// whose new state is outside the envelope (index, violation).
+    fn advance_stage(&mut self, schedule: Schedule, slot: Slot) -> Option<(usize, Violation)> {
+        let leader = slot.exchange.then(|| {
+            self.publish_if_needed(slot);
+            Judged::of(self.leader.stage_exchange())
+        });
+        self.leader.advance();
+        let next = schedule.next(slot).filter(|x| x.exchange);
+        let stage = Stage {
+            leader,
+            publish: next.is_some(),
+            check: slot.ends_step().then_some(&self.net.guard),
+        };
+        // Read this exchange's buffer; write the next exchange's (the
+        // other one at an exchange; nothing is read otherwise).
+        let [now, after] = &mut self.published;
+        let (read, out) = if slot.exchange {
+            (&*now, after)
+        } else {
+            (&*after, now)
+        };
+        let found = pass(
+            &mut self.agents,
+            &self.nbr_index,
+            (stage, &mut self.scratch),
+            |j| &read[j],
+            |k, a| {
+                let Judged(x, trusted) = &mut out[k];
+                *trusted = a.publish_into(x);
+                if !*trusted {
+                    *x = read[k].0;
+                }
+            },
+        );
+        if slot.exchange {
+            self.published.swap(0, 1);
+        }
+        if let Some(x) = next {
+            self.ready = Some((x.step, x.stage));
+        }
         found
     }
 
@@ -249,8 +316,10 @@ impl InProcess {
         (self.sampled.0, &self.sampled.1)
     }
 
-    /// Books the current step as sampled, does `work` for every agent
-    /// into `outs`, then hands the snapshot and `outs` to `f`.
+    /// Books the current step as sampled (its peak torques first), evaluates
+    /// its stage 0 for the torques ([`Self::begin_serial`]; NaN at the
+    /// horizon), does `work` for every agent into `outs`, then hands the
+    /// snapshot and `outs` to `f`.
     fn sample<T>(
         &mut self,
         (work, outs): Work<'_, T, impl PerAgent<T>>,
@@ -259,6 +328,13 @@ impl InProcess {
         self.sampled.0 = self.step;
         self.sampled.1.clear();
         (self.sampled.1).extend(self.agents.iter().map(Agent::peak_torque));
+        self.torques.clear();
+        if self.step < self.net.steps {
+            self.begin_serial();
+            self.torques.extend(self.agents.iter().map(Agent::torque));
+        } else {
+            self.torques.resize(self.agents.len(), NO_TORQUE);
+        }
         outs.clear();
         let leader = self.leader.state();
         outs.extend((self.states.iter().enumerate()).map(|(k, x)| work(k, x, leader)));
@@ -273,10 +349,11 @@ impl InProcess {
     }
 
     /// Runs to the end, calling `on_sample` at t = 0 and every
-    /// `sample_every` steps. Stops early if `on_sample` returns `false`,
-    /// and at once (before sampling) when a state leaves the envelope:
-    /// then it returns the divergence. The state is checked at t = 0 and
-    /// after every step.
+    /// `sample_every` steps (each once stage 0 of its step gave the
+    /// torques). Stops early if `on_sample` returns `false` (then within
+    /// the sampled step, after its stage 0), and at once (before sampling)
+    /// when a state leaves the envelope: then it returns the divergence.
+    /// The state is checked at t = 0 and after every step.
     pub fn run(&mut self, mut on_sample: impl FnMut(&Snapshot<'_>) -> bool) -> Option<Divergence> {
         self.run_with(|_, _, _| (), |snap, _| on_sample(snap))
     }
@@ -315,7 +392,8 @@ impl InProcess {
         }
         if self.threads > 1 && self.step < self.net.steps {
             self.ready = None;
-            let diverged = self.run_parallel((&work, &mut outs), on_sample, stop);
+            let (diverged, begun) = self.run_parallel((&work, &mut outs), on_sample, stop);
+            self.begun = begun;
             self.refresh_states();
             return diverged;
         }
@@ -340,20 +418,23 @@ impl InProcess {
 
     /// [`Self::run_with`] on `self.threads` threads: the calling thread
     /// steps the leader and the first share and samples; a worker steps
-    /// each other share (see `crew`).
+    /// each other share (see `crew`). Returns the divergence, and whether
+    /// it stopped within a step (after a sample's stage 0).
     fn run_parallel<T: Send>(
         &mut self,
         (work, all): Work<'_, T, impl PerAgent<T> + Sync>,
         mut on_sample: impl OnSample<T>,
         stop: impl Fn() -> bool,
-    ) -> Option<Divergence> {
+    ) -> (Option<Divergence>, bool) {
         let Self {
             net,
             leader,
             agents,
             nbr_index,
             step,
+            begun,
             states,
+            torques,
             threads,
             sampled,
             published,
@@ -366,17 +447,19 @@ impl InProcess {
             sample_every: net.sample_every,
             guard: &net.guard,
         };
-        let (from, outs) = (*step, crew::outputs::<T>(*threads));
-        let (diverged, parity) = std::thread::scope(|scope| {
+        let (from, outs) = ((*step, *begun), crew::outputs::<T>(*threads));
+        let (diverged, parity, within) = std::thread::scope(|scope| {
             let mut shares = Share::split(agents, *threads).into_iter();
             let mut mine = shares.next().expect("at least one share");
             for (share, out) in shares.zip(&outs[1..]) {
                 let board = &board;
                 scope.spawn(move || crew::work(share, board, plan, from, (work, out)));
             }
-            let ended = |mine: &Share<'_>, d| (d, mine.parity());
+            let ended = |mine: &Share<'_>, d, within| (d, mine.parity(), within);
+            let mut skip = usize::from(*begun);
             while *step < net.steps {
-                mine.step(&board, plan, *step, Some(leader));
+                mine.step(&board, plan, (*step, skip), Some(leader));
+                skip = 0;
                 *step += 1;
                 let due = plan.sample_due(*step);
                 if due {
@@ -387,33 +470,46 @@ impl InProcess {
                 let found = crew::read_found(&board);
                 if let Some(d) = divergence_at(net, *step, leader.state(), found) {
                     crew::release(&board, false);
-                    return ended(&mine, Some(d));
+                    return ended(&mine, Some(d), false);
                 }
                 if !due {
                     let go_on = !stop();
                     crew::release(&board, go_on);
                     if !go_on {
-                        return ended(&mine, None);
+                        return ended(&mine, None, false);
                     }
                     continue;
                 }
                 sampled.0 = *step;
                 crew::read_peaks(&board, &mut sampled.1);
+                // Stage 0 of the sampled step, for its torques (none after
+                // the last step).
+                let begins = *step < net.steps;
+                if begins {
+                    crew::release(&board, true);
+                    mine.begin(&board, plan, *step, Some(leader));
+                    crew::read_torques(&board, torques);
+                    skip = 1;
+                } else {
+                    torques.clear();
+                    torques.resize(states.len(), NO_TORQUE);
+                }
                 let snapshot = Snapshot {
                     step: *step,
                     leader: leader.state(),
                     agents: states,
+                    torques,
                 };
                 let go_on = on_sample(&snapshot, all.as_slice());
                 crew::release(&board, go_on);
                 if !go_on {
-                    return ended(&mine, None);
+                    return ended(&mine, None, begins);
                 }
             }
-            ended(&mine, None)
+            ended(&mine, None, false)
         });
         crew::read_published(&board, parity, published);
-        diverged
+        (diverged, within)
     }
 }
 

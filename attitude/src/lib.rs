@@ -17,7 +17,10 @@
 //!   `controlconstantestimate`, `districontrol`; the printed `sigmai`,
 //!   `gammai` as a negative control ([`control::ControlLaw`]).
 //! - [`actuator`]: actuator limits (the torque a body can apply);
-//!   [`effects`]: a body's non-ideal effects, grouped.
+//!   [`disturbance`]: torques from outside; [`sensor`]: what the law
+//!   measures of its own body; [`effects`]: a body's non-ideal effects,
+//!   grouped (with the inertia the law assumes), and their state.
+//! - [`random`]: the seeded streams (SplitMix64, normal deviates).
 //! - [`network`]: the resolved network every engine runs.
 //! - [`link`]: delay, jitter, loss and per-link period, on the receiving side.
 //! - [`timeline`]: events in steps: link outages, retunes, repoints.
@@ -38,6 +41,7 @@ pub mod agent;
 pub mod body;
 pub mod checks;
 pub mod control;
+pub mod disturbance;
 pub mod effects;
 pub mod engine;
 pub mod guard;
@@ -47,8 +51,10 @@ pub mod link;
 pub mod metrics;
 pub mod network;
 pub mod observer;
+pub mod random;
 pub mod reference;
 pub mod schedule;
+pub mod sensor;
 pub mod so3;
 pub mod sparse;
 pub mod spectrum;

@@ -29,6 +29,7 @@
 //! stays byte-identical to the plain engine.
 
 use crate::network::Exchanged;
+use crate::random::SplitMix64;
 use crate::timeline::Outage;
 use serde::{Deserialize, Serialize};
 use std::cmp::Reverse;
@@ -94,30 +95,11 @@ impl LinkModel {
     }
 }
 
-/// SplitMix64: a small, well-mixed, seedable stream (Steele et al. 2014).
-#[derive(Debug, Clone)]
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
-
 /// Mixes a scenario seed with a link's ends into the link's seed.
 #[must_use]
 pub fn link_seed(seed: u64, from: u32, to: u32) -> u64 {
     let mut s = SplitMix64(seed ^ (u64::from(from) << 32 | u64::from(to)).rotate_left(17));
-    s.next()
+    s.next_u64()
 }
 
 /// Counters of one link, for the results.
@@ -239,7 +221,7 @@ impl Link {
             return;
         }
         let jitter = if self.model.jitter > 0 {
-            self.rng.next() % (self.model.jitter + 1)
+            self.rng.next_u64() % (self.model.jitter + 1)
         } else {
             0
         };

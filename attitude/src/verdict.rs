@@ -32,6 +32,7 @@
 
 use crate::network::{Exchanged, ROTATION_TOLERANCE};
 use nalgebra::Vector3;
+use std::num::NonZeroU64;
 
 /// Largest orthogonality defect `‖QᵀQ − I‖_F` of a step's start attitude
 /// for which the verdicts of the step's other stages are proven.
@@ -46,10 +47,22 @@ pub const MAX_INCREMENT2: f64 = 1.0;
 /// step whose start attitude is a rotation to [`MARGIN`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Verdicts {
-    proven_for: Option<u64>,
+    proven_for: Option<Step>,
     /// A step whose start state passed the guard ([`Verdicts::checked`]),
-    /// and the defect of its published attitude.
-    checked: Option<(u64, f64)>,
+    /// and the defect of its published attitude (meaningful with the step).
+    checked: (Option<Step>, f64),
+}
+
+/// A step index `n` kept as `n + 1`, so that `Option<Step>` takes 8 bytes
+/// (the verdicts sit in every agent, whose size is its working set:
+/// `attitude/tests/layout.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Step(NonZeroU64);
+
+impl Step {
+    fn of(n: u64) -> Option<Self> {
+        NonZeroU64::new(n.wrapping_add(1)).map(Self)
+    }
 }
 
 impl Verdicts {
@@ -60,7 +73,7 @@ impl Verdicts {
     /// guard's checks imply [`Exchanged::trust`]'s (finite entries, the same
     /// defect and determinant, finite norms hence finite vectors).
     pub fn checked(&mut self, n: u64, defect: f64) {
-        self.checked = Some((n, defect));
+        self.checked = (Step::of(n), defect);
     }
 
     /// The verdict on `x`, published at stage `stage` of step `n`, whose
@@ -68,14 +81,21 @@ impl Verdicts {
     /// the start attitude itself). Always equal to `x.trust().is_ok()`.
     pub fn judge(&mut self, x: &Exchanged, n: u64, stage: usize, u: &Vector3<f64>) -> bool {
         if stage == 0 {
-            let defect = match self.checked.take() {
-                Some((m, d)) if m == n => Some(d),
+            let checked = std::mem::take(&mut self.checked);
+            let defect = match checked {
+                (Some(m), d) if Some(m) == Step::of(n) => Some(d),
                 _ => x.trusted_defect().ok(),
             };
-            self.proven_for = defect.is_some_and(|d| d <= MARGIN).then_some(n);
+            self.proven_for = defect
+                .is_some_and(|d| d <= MARGIN)
+                .then(|| Step::of(n))
+                .flatten();
             return defect.is_some();
         }
-        if self.proven_for == Some(n) && u.norm_squared() <= MAX_INCREMENT2 {
+        if self.proven_for.is_some()
+            && self.proven_for == Step::of(n)
+            && u.norm_squared() <= MAX_INCREMENT2
+        {
             return Exchanged::finite(x.w.as_slice()) && Exchanged::finite(x.s.as_slice());
         }
         x.trust().is_ok()

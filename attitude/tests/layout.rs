@@ -15,7 +15,8 @@ fn an_agents_working_set_does_not_grow() {
         ("Agent (inline)", size_of::<Agent>(), 1408),
         // 528 B before issue 35: + two boxed pointers (the timeline, the
         // body's effects); the Agent did not grow (it no longer keeps `dt`
-        // beside its integrator's).
+        // beside its integrator's; the stage-0 torque it now keeps took the
+        // bytes its verdicts' and refusal counters' representations gave up).
         ("AgentModel (in Agent)", size_of::<AgentModel>(), 544),
         (
             "AgentState (step start, stage point)",

@@ -92,9 +92,10 @@ START, STOP = 1, 2
 # reserved: u32) and a 232-byte body laid out per kind; unused bytes are 0.
 TELEMETRY_SIZE = 248
 TELEMETRY_HEADER = struct.Struct("<IIII")
-READY, SAMPLE, DONE, LINK_STATS, FAILED = 1, 2, 3, 4, 5
+READY, SAMPLE, DONE, LINK_STATS, FAILED, TORQUE = 1, 2, 3, 4, 5, 7
 # Bodies, all starting at offset 16:
 SAMPLE_BODY = struct.Struct("<Q9d3d9d3d3dd")  # step, r, w, r_hat, w_hat, s_hat, peak_torque
+TORQUE_BODY = struct.Struct("<Q3d")  # step, tau (applied at stage 0 of the step)
 DONE_BODY = struct.Struct("<QdQQQQd")  # steps, peak_torque, peak_rss_kb, started_unix_ns,
 #                                        done_unix_ns, late_stages, max_lateness
 LINK_STATS_BODY = struct.Struct("<I4xQQQQQdd")  # from, sent, delivered, lost, rejected,
@@ -475,6 +476,7 @@ class Agent:
         # until something valid arrives (§ 8).
         self.held = [(IDENTITY, ZERO, ZERO)] * (len(self.gains) + (self.leader_gain is not None))
         self.peak_torque = 0.0
+        self.tau0 = ZERO  # the torque applied at stage 0 of the current step
         r, w = matrix(initial["r"]), vec3(initial["w"])
         r_hat = matrix(initial["r_hat"])
         w_hat, s_hat = vec3(initial["w_hat"]), vec3(initial["s_hat"])
@@ -527,6 +529,7 @@ class Agent:
             tau = tau_districontrol(self.control, r, w, self.gains, nbrs, leader)
         if self.rk.stage == 0:  # only the torque at a step's start counts
             self.peak_torque = max(self.peak_torque, norm(tau))
+            self.tau0 = tau
         w_dot = omega_dot(self.j, self.j_inv, w, tau)
         if self.observer:
             return self.rk.push([w, w_hat], [w_dot, w_hat_dot, s_hat_dot])
@@ -537,6 +540,11 @@ class Agent:
         r, w, r_hat, w_hat, s_hat = self.state()
         return telemetry(node_id, SAMPLE, SAMPLE_BODY, step, *r, *w, *r_hat, *w_hat,
                          *s_hat, self.peak_torque)
+
+    def torque(self, node_id, step):
+        """Telemetry Torque (kind 7): the torque applied at stage 0 of the
+        current step, which is step `step`."""
+        return telemetry(node_id, TORQUE, TORQUE_BODY, step, *self.tau0)
 
 
 def gains_of(g):
@@ -1017,6 +1025,8 @@ def lockstep(ports, cfg, agent, refusals, orphan):
                     if value is not None:  # a refused value is like a lost one
                         agent.receive(k, value)
             agent.advance()
+            if s == 0 and n % sample_every == 0:
+                ports.report(agent.torque(node_id, n))
         if (n + 1) % sample_every == 0 or n + 1 == steps:
             ports.report(agent.sample(node_id, n + 1))
     return 0, 0.0
@@ -1117,6 +1127,8 @@ def realtime(ports, cfg, agent, refusals, orphan, start_unix_ns):
                         meter.held_sent_ns = fresh[1]
                     meter.age(factor)
             agent.advance()
+            if s == 0 and n % sample_every == 0:
+                ports.report(agent.torque(node_id, n))
         if (n + 1) % sample_every == 0 or n + 1 == steps:
             ports.report(agent.sample(node_id, n + 1))
     return (late_stages, max_lateness), meters, exchanges

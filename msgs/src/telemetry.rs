@@ -34,6 +34,16 @@ pub enum Telemetry {
         /// Largest ‖τᵢ‖ applied so far, N·m.
         peak_torque: f64,
     },
+    /// The torque an agent applied at stage 0 of step `step` (t = n·dt,
+    /// from the step's start state), sent once that stage was evaluated,
+    /// at sampled steps before the last; optional (a node that never
+    /// sends it has its torques recorded as NaN).
+    Torque {
+        /// Step index n.
+        step: u64,
+        /// `τᵢ` after the actuator's limits, N·m, body frame.
+        tau: Vector3<f64>,
+    },
     /// The leader's state at the start of step `step`.
     LeaderSample {
         /// Step index n.
@@ -52,6 +62,19 @@ pub enum Telemetry {
     Done(Done),
     /// The node gives up while stepping, just before it exits.
     Failed(FailReason),
+}
+
+impl Telemetry {
+    /// Whether this is a periodic report of the trajectory (`Sample`,
+    /// `LeaderSample`, `Torque`): sent without waking the orchestrator,
+    /// which drains its telemetry often anyway (PROTOCOL.md § 6).
+    #[must_use]
+    pub fn is_sample(&self) -> bool {
+        matches!(
+            self,
+            Self::Sample { .. } | Self::LeaderSample { .. } | Self::Torque { .. }
+        )
+    }
 }
 
 /// The end of a node's steps.
@@ -123,13 +146,33 @@ pub enum TelemetryKind {
     Failed = 5,
     /// [`Telemetry::LeaderSample`].
     LeaderSample = 6,
+    /// [`Telemetry::Torque`].
+    Torque = 7,
 }
 
 impl TelemetryKind {
+    /// Every kind.
+    pub const ALL: [Self; 7] = [
+        Self::Ready,
+        Self::Sample,
+        Self::Done,
+        Self::LinkStats,
+        Self::Failed,
+        Self::LeaderSample,
+        Self::Torque,
+    ];
+
+    /// The kind whose wire code is `code` (`None`: no kind has it).
+    #[must_use]
+    pub fn of_code(code: u32) -> Option<Self> {
+        Self::ALL.into_iter().find(|&k| k as u32 == code)
+    }
+
     fn of(t: &Telemetry) -> Self {
         match t {
             Telemetry::Ready => Self::Ready,
             Telemetry::Sample { .. } => Self::Sample,
+            Telemetry::Torque { .. } => Self::Torque,
             Telemetry::LeaderSample { .. } => Self::LeaderSample,
             Telemetry::LinkStats { .. } => Self::LinkStats,
             Telemetry::Done(_) => Self::Done,
@@ -232,6 +275,10 @@ impl TelemetryMsg {
                 b.f64s(216, state.s_hat.as_slice());
                 b.f64(240, *peak_torque);
             }
+            Telemetry::Torque { step, tau } => {
+                b.u64(16, *step);
+                b.f64s(24, tau.as_slice());
+            }
             Telemetry::LeaderSample { step, state } => {
                 b.u64(16, *step);
                 b.f64s(24, &to_rows(&state.r0));
@@ -260,9 +307,11 @@ impl TelemetryMsg {
             });
         }
         let b = Reader(&self.body);
-        Ok(match self.kind {
-            1 => Telemetry::Ready,
-            2 => Telemetry::Sample {
+        let kind =
+            TelemetryKind::of_code(self.kind).ok_or(TelemetryError::UnknownKind(self.kind))?;
+        Ok(match kind {
+            TelemetryKind::Ready => Telemetry::Ready,
+            TelemetryKind::Sample => Telemetry::Sample {
                 step: b.u64(16),
                 state: AgentState {
                     r: from_rows(&b.f64s(24)),
@@ -273,7 +322,7 @@ impl TelemetryMsg {
                 },
                 peak_torque: b.f64(240),
             },
-            6 => Telemetry::LeaderSample {
+            TelemetryKind::LeaderSample => Telemetry::LeaderSample {
                 step: b.u64(16),
                 state: LeaderState {
                     r0: from_rows(&b.f64s(24)),
@@ -281,10 +330,13 @@ impl TelemetryMsg {
                     s0: Vector3::from(b.f64s(120)),
                 },
             },
-            4 => decode_link_stats(&b),
-            3 => Telemetry::Done(decode_done(&b)),
-            5 => Telemetry::Failed(decode_failed(&b)?),
-            k => return Err(TelemetryError::UnknownKind(k)),
+            TelemetryKind::Torque => Telemetry::Torque {
+                step: b.u64(16),
+                tau: Vector3::from(b.f64s(24)),
+            },
+            TelemetryKind::LinkStats => decode_link_stats(&b),
+            TelemetryKind::Done => Telemetry::Done(decode_done(&b)),
+            TelemetryKind::Failed => Telemetry::Failed(decode_failed(&b)?),
         })
     }
 }
@@ -471,6 +523,10 @@ mod tests {
                 state: agent_state(),
                 peak_torque: 2.5,
             },
+            Telemetry::Torque {
+                step: 40,
+                tau: Vector3::new(-0.0, 5e-324, f64::NAN),
+            },
             Telemetry::LeaderSample {
                 step: u64::MAX,
                 state: LeaderState {
@@ -514,8 +570,44 @@ mod tests {
         for t in all {
             let m = TelemetryMsg::encode(4, &t);
             assert_eq!(m.sender, 4);
-            assert_eq!(m.decode(), Ok(t), "{t:?}");
+            let back = m.decode().expect("decodes");
+            assert_eq!(
+                TelemetryMsg::encode(4, &back).body,
+                m.body,
+                "{t:?} (bit for bit, NaN included)"
+            );
+            if !matches!(t, Telemetry::Torque { .. }) {
+                assert_eq!(back, t, "{t:?}");
+            }
         }
+    }
+
+    #[test]
+    fn a_torque_is_kind_7_with_its_step_at_16_and_tau_at_24() {
+        let tau = Vector3::new(0.5, -1.25, 3e-7);
+        let m = TelemetryMsg::encode(5, &Telemetry::Torque { step: 90, tau });
+        assert_eq!(m.kind, 7);
+        assert_eq!(TelemetryKind::of_code(7), Some(TelemetryKind::Torque));
+        // The 8 bytes at message offset `o`.
+        let at = |o: usize| &m.body[o - 16..o - 8];
+        assert_eq!(u64::from_le_bytes(at(16).try_into().unwrap()), 90);
+        for (k, x) in tau.iter().enumerate() {
+            assert_eq!(f64::from_le_bytes(at(24 + 8 * k).try_into().unwrap()), *x);
+        }
+        assert!(m.body[48 - 16..].iter().all(|&b| b == 0), "the rest is 0");
+        assert_eq!(m.decode(), Ok(Telemetry::Torque { step: 90, tau }));
+        assert!(Telemetry::Torque { step: 90, tau }.is_sample());
+        assert!(!Telemetry::Ready.is_sample());
+    }
+
+    #[test]
+    fn every_kind_has_its_own_code() {
+        for (k, kind) in TelemetryKind::ALL.into_iter().enumerate() {
+            assert_eq!(kind as u32, k as u32 + 1);
+            assert_eq!(TelemetryKind::of_code(kind as u32), Some(kind));
+        }
+        assert_eq!(TelemetryKind::of_code(0), None);
+        assert_eq!(TelemetryKind::of_code(8), None);
     }
 
     #[test]

@@ -201,7 +201,8 @@ pub fn run(loaded: &Loaded, opts: &RunOptions, interrupt: &Interrupt) -> Result<
         let data = view::view_data(&loaded.resolved.network, view::run_info(&summary), frames);
         view::write(&layout.view(), &data)?;
     }
-    write_results(&layout, &summary, &series)?;
+    let torque_plot = loaded.scenario.output.torque_plot;
+    write_results(&layout, &summary, (&series, torque_plot))?;
     (manifest(loaded, opts, &summary, &text, started_at).write(&layout)).map_err(written)?;
     staging.commit().map_err(io_at(&opts.out))?;
     tracing::debug!(out = %opts.out.display(), complete = summary.complete, "run: committed");
@@ -376,6 +377,11 @@ fn drive_in_process(
             break (diverged, verdict);
         }
         engine.extend_to(until::next_horizon(engine.horizon(), max, net.sample_every));
+        // The former last sample had no torques (no step followed it): now one does.
+        let step = engine.step_index();
+        if let Some(torques) = engine.begin_step() {
+            rec.recorder.amend_torques(step, torques);
+        }
         bar.set_length(engine.horizon());
     };
     let stopped = diverged.is_none() && engine.step_index() < engine.horizon();
@@ -561,9 +567,14 @@ fn hosts_summary(hosts: &Hosts) -> Option<results::summary::HostsSummary> {
     Some(results::summary::HostsSummary::of(names, &security))
 }
 
-/// Writes the plot, then `summary.json` (last: it marks the directory as
-/// complete results).
-fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Result<(), RunError> {
+/// Writes the plot (with the torque panel if `torque_plot`: the scenario's
+/// `[output] torque_plot`), then `summary.json` (last: it marks the
+/// directory as complete results).
+fn write_results(
+    layout: &RunLayout,
+    summary: &Summary,
+    (series, torque_plot): (&[Series], bool),
+) -> Result<(), RunError> {
     let svg = layout.errors_svg();
     let title = format!("{} ({})", summary.scenario, summary.engine);
     // Real-time runs measure every link's age of information; lockstep
@@ -579,11 +590,10 @@ fn write_results(layout: &RunLayout, summary: &Summary, series: &[Series]) -> Re
             label: e.what.to_string(),
         })
         .collect();
-    plot::draw(&svg, &title, series, aoi, &marks).map_err(|plot::PlotError(message)| {
-        RunError::Plot {
-            path: svg.clone(),
-            message,
-        }
+    let drawn = plot::draw(&svg, &title, series, aoi, &marks, torque_plot);
+    drawn.map_err(|plot::PlotError(message)| RunError::Plot {
+        path: svg.clone(),
+        message,
     })?;
     results::write_summary(layout.root(), summary).map_err(written)
 }

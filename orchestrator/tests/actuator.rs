@@ -8,6 +8,8 @@
 //!   without one;
 //! - both engines are byte-identical with limits;
 //! - an agent's own limit replaces `[actuator]` for it alone;
+//! - a rate limit moves the applied torque at most `ρ·dt` per step (from
+//!   zero before the first step), byte-identical in both engines;
 //! - bad bounds are refused (exit 2) naming the field.
 
 mod common;
@@ -140,10 +142,52 @@ fn bad_bounds_are_refused_naming_the_field() {
             "[actuator]\nmax_torque = 1.0\nrate = 2.0\n",
             "rate",
         ),
+        (
+            "rate",
+            "[actuator]\nmax_torque_rate = -3.0\n",
+            "actuator.max_torque_rate: a torque rate bound must be finite and > 0 N·m/s, got -3",
+        ),
+        (
+            "empty",
+            "[actuator]\n",
+            "actuator: needs max_torque, max_torque_rate or both",
+        ),
     ] {
         let file = scenario(tmp.path(), name, table);
         let o = attsync(tmp.path(), &["check".as_ref(), file.as_os_str()]);
         o.assert_code(2);
         assert!(o.stderr.contains(says), "{name}: {}", o.stderr);
     }
+}
+
+#[test]
+fn a_rate_limit_moves_the_applied_torque_at_most_rho_dt_per_step() {
+    let tmp = tempfile::tempdir().unwrap();
+    let table = "[actuator]\nmax_torque = 2.0\nmax_torque_rate = 5.0\n";
+    let file = scenario(tmp.path(), "rate", table);
+    let a = run(tmp.path(), &file, "in-process", "rate-a");
+    let b = run(tmp.path(), &file, "processes", "rate-b");
+    assert!(same_bits(&a, &b), "the engines differ");
+    // every step's stage-0 torque, from the model itself
+    let text = read(&file);
+    let set = ["simulation.duration=3".to_string()];
+    let loaded = attsync::scenario::load_str(&file, &text, &set).unwrap();
+    let net = loaded.resolved.network;
+    let dt = net.dt;
+    let mut engine = attitude::engine::InProcess::new(&net);
+    let mut before: Vec<nalgebra::Vector3<f64>> = vec![nalgebra::Vector3::zeros(); 7];
+    let (mut fastest, mut limited) = (0.0f64, 0usize);
+    for _ in 0..net.steps {
+        engine.step();
+        for (k, agent) in engine.agents().iter().enumerate() {
+            let tau = agent.torque();
+            let rate = (tau - before[k]).norm() / dt;
+            fastest = fastest.max(rate);
+            limited += usize::from(rate > 5.0 * 0.999);
+            assert!(tau.norm() <= 2.0 * (1.0 + 4.0 * f64::EPSILON));
+            before[k] = tau;
+        }
+    }
+    assert!(fastest <= 5.0 * (1.0 + 1e-9), "{fastest} N·m/s > 5");
+    assert!(limited > 100, "the limit hardly acted: {limited} steps");
 }

@@ -91,12 +91,12 @@ fn round_trip(name: &str) -> (String, String) {
 fn the_observer_run_reads_back_with_every_frame_and_error() {
     let (said, checked) = round_trip("timevarying");
     assert!(
-        said.contains("11 samples, 8 channels, 88 messages"),
+        said.contains("11 samples, 15 channels, 165 messages"),
         "{said}"
     );
     assert!(
         checked.contains(
-            "mcap ok: 11 samples, 7 agents, 8 channels, 88 messages, observer true, \
+            "mcap ok: 11 samples, 7 agents, 15 channels, 165 messages, observer true, \
              last log time 100000000 ns"
         ),
         "{checked}"
@@ -107,7 +107,8 @@ fn the_observer_run_reads_back_with_every_frame_and_error() {
 fn the_observerless_run_reads_back_without_estimates() {
     let (_, checked) = round_trip("constant-observerless");
     assert!(
-        checked.contains("mcap ok: 11 samples, 7 agents, 8 channels, 88 messages, observer false"),
+        checked
+            .contains("mcap ok: 11 samples, 7 agents, 15 channels, 165 messages, observer false"),
         "{checked}"
     );
 }

@@ -30,7 +30,7 @@ fn export_matches_errors_csv() {
     let text = exported.stdout;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(header.len(), 2 + 9 + 3 + 9 + 3 + 3);
+    assert_eq!(header.len(), 2 + 9 + 3 + 9 + 3 + 3 + 3);
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 11 * 8, "11 samples × (leader + 7 agents)");
     let errors = std::fs::read_to_string(out.join("errors.csv")).unwrap();

@@ -152,13 +152,13 @@ fn a_flipped_byte_of_states_bin_is_found_and_placed() {
     let id = |k: usize| u32::from_le_bytes(bytes[ids_at + 8 + 4 * k..][..4].try_into().unwrap());
     let agent_id = id(1); // the agent index below
     let header = ids_at + 8 + 4 * n + 1;
-    // Record: step 8, leader 15 f64, agents (u64 length + 27 f64 each:
-    // r 9, w 3, r_hat 9, w_hat 3, s_hat 3). Sample 3, agent index 1, R̂[1][2].
-    let record = 8 + 15 * 8 + 8 + 27 * 8 * n;
+    // Record: step 8, leader 15 f64, agents (u64 length + 30 f64 each:
+    // r 9, w 3, r_hat 9, w_hat 3, s_hat 3, tau 3). Sample 3, agent index 1, R̂[1][2].
+    let record = 8 + 15 * 8 + 8 + 30 * 8 * n;
     let sample = 3;
     let start = header + sample * record;
     let (agent, r_hat, row, col) = (1, 9 + 3, 1, 2);
-    let at = start + 8 + 15 * 8 + 8 + 27 * 8 * agent + (r_hat + 3 * row + col) * 8;
+    let at = start + 8 + 15 * 8 + 8 + 30 * 8 * agent + (r_hat + 3 * row + col) * 8;
     let value = |b: &[u8]| f64::from_le_bytes(b[at..at + 8].try_into().unwrap());
     let original = value(&bytes);
     let step = u64_at(&bytes, start);

@@ -28,6 +28,7 @@
 //! - [`report`] — the text `attsync check` prints;
 //! - `error` — [`ScenarioError`].
 
+pub mod body;
 mod borrowed;
 pub mod deserialize;
 mod document;

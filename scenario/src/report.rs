@@ -52,6 +52,7 @@ pub fn describe(l: &Loaded) -> String {
             let _ = writeln!(s, "  - {d}: {}", d.lost());
         }
     }
+    bodies(&mut s, n);
     if !r.events.is_empty() {
         s.push_str("events:\n");
         for e in &r.events {
@@ -106,6 +107,32 @@ fn agents(s: &mut String, n: &attitude::network::Network) {
             ""
         };
         let _ = writeln!(s, "]{leader}");
+    }
+}
+
+/// The bodies that aren't ideal, grouped by what they have:
+/// `bodies:` then `  - agents 1, 2: torque ≤ 2 N·m; …` (nothing when
+/// every body is ideal).
+fn bodies(s: &mut String, n: &attitude::network::Network) {
+    let mut groups: Vec<(String, Vec<u32>)> = Vec::new();
+    for a in &n.agents {
+        let Some(e) = a.model.effects.as_deref() else {
+            continue;
+        };
+        let text = crate::body::describe(e);
+        match groups.iter_mut().find(|(t, _)| *t == text) {
+            Some((_, ids)) => ids.push(a.model.id),
+            None => groups.push((text, vec![a.model.id])),
+        }
+    }
+    if groups.is_empty() {
+        return;
+    }
+    s.push_str("bodies:\n");
+    for (text, ids) in groups {
+        let noun = if ids.len() == 1 { "agent" } else { "agents" };
+        let ids: Vec<String> = ids.iter().map(u32::to_string).collect();
+        let _ = writeln!(s, "  - {noun} {}: {text}", ids.join(", "));
     }
 }
 

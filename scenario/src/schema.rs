@@ -38,6 +38,16 @@ pub struct Scenario {
     /// `[actuator]`: every agent's actuator limits (default: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub actuator: Option<ActuatorSpec>,
+    /// `[[disturbance]]`: torques from outside (default: none).
+    #[serde(default, rename = "disturbance", skip_serializing_if = "Vec::is_empty")]
+    pub disturbances: Vec<crate::body::DisturbanceSpec>,
+    /// `[sensor]`: every agent's sensor errors (default: exact).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<crate::body::SensorSpec>,
+    /// `[controller]`: what every agent's law assumes of its body (default:
+    /// the body's inertia).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller: Option<crate::body::ControllerSpec>,
     /// `[graph]`: whether the paper's Assumption 1 is enforced.
     #[serde(default, skip_serializing_if = "GraphSpec::is_default")]
     pub graph: GraphSpec,
@@ -197,6 +207,10 @@ pub struct Output {
     /// Period of the rows of `errors.csv`, s (a multiple of `dt`).
     #[serde(default = "default_sample_period")]
     pub sample_period: f64,
+    /// Draw the torque each agent applied, `‖τᵢ‖`, in a panel of
+    /// `errors.svg` (default false: the plot as without it).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub torque_plot: bool,
 }
 
 fn default_sample_period() -> f64 {
@@ -207,6 +221,7 @@ impl Default for Output {
     fn default() -> Self {
         Self {
             sample_period: default_sample_period(),
+            torque_plot: false,
         }
     }
 }
@@ -332,6 +347,12 @@ pub struct AgentSpec {
     /// This agent's actuator limits (in place of `[actuator]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub actuator: Option<ActuatorSpec>,
+    /// This agent's sensor errors (in place of `[sensor]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sensor: Option<crate::body::SensorSpec>,
+    /// What this agent's law assumes of its body (in place of `[controller]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller: Option<crate::body::ControllerSpec>,
 }
 
 /// `[actuator]` or `agent.actuator`: the torque a body can apply.
@@ -340,7 +361,11 @@ pub struct AgentSpec {
 pub struct ActuatorSpec {
     /// N·m: one number, the largest `‖τ‖` (norm saturation), or three,
     /// the largest `|τ_k|` per body axis (per-axis saturation).
-    pub max_torque: TorqueLimit,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_torque: Option<TorqueLimit>,
+    /// N·m/s: the largest rate of change of the applied torque (by norm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_torque_rate: Option<f64>,
 }
 
 /// `max_torque = 0.5` or `max_torque = [0.2, 0.3, 0.2]`.

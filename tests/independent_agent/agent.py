@@ -253,6 +253,8 @@ class Node:
                             ages[k][0] += age
                             ages[k][1] = max(ages[k][1], age)
                 agent.evaluate(s)
+                if s == 0 and n % every == 0:
+                    self.telemetry(wire.torque(self.id, n, agent.torque))
             if (n + 1) % every == 0 or n + 1 == steps:
                 self.report_sample(agent, n + 1)
         done = time.time_ns()

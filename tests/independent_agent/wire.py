@@ -6,7 +6,7 @@ import struct
 PROTOCOL_VERSION = 3
 
 # Telemetry kinds (§ 5).
-READY, SAMPLE, DONE, LINK_STATS, FAILED, LEADER_SAMPLE = 1, 2, 3, 4, 5, 6
+READY, SAMPLE, DONE, LINK_STATS, FAILED, LEADER_SAMPLE, TORQUE = 1, 2, 3, 4, 5, 6, 7
 # Failed reasons.
 TIMED_OUT, BROKE_PROTOCOL, OTHER = 1, 2, 3
 # Control commands.
@@ -100,6 +100,12 @@ def sample(sender, n, r, w, rh, wh, sh, peak_torque):
     """Kind 2: step u64 @16, r @24, w @96, r_hat @120, w_hat @192,
     s_hat @216, peak_torque @240."""
     return telemetry(sender, SAMPLE, "Q9d3d9d3d3d1d", n, *r, *w, *rh, *wh, *sh, peak_torque)
+
+
+def torque(sender, n, tau):
+    """Kind 7: step u64 @16, tau f64[3] @24 (the torque applied at stage 0
+    of step n)."""
+    return telemetry(sender, TORQUE, "Q3d", n, *tau)
 
 
 def done(sender, steps, peak_torque, peak_rss_kb, started_ns, done_ns):

@@ -9,14 +9,17 @@ and every message is decoded by `mcap-protobuf-support` through the schema
 embedded in the file (a FileDescriptorSet: nothing of attsync is known
 here), then checked against the CSVs:
 
-- the channels: /tf (foxglove.FrameTransforms) and /errors/agent-<id>
-  (attsync.AgentErrors), all Protobuf;
+- the channels: /tf (foxglove.FrameTransforms), /errors/agent-<id>
+  (attsync.AgentErrors) and /torque/agent-<id> (attsync.AgentTorque), all
+  Protobuf;
 - one message per sample on every channel, log time = publish time = the
   sample's simulated time in ns, and the summary's statistics agree;
 - every transform: parent `world`, the frames leader, agent-<id> and
   estimate-<id> (observer schemes), stamped with the log time, a unit
   quaternion whose rotation matrix is the CSV's R0 / R_i / R_hat_i;
-- every error message: the values of errors.csv, exactly.
+- every error message: the values of errors.csv, exactly;
+- every torque message: the CSV's tau1..tau3 of the agent, exactly, and
+  their norm (NaN at the last sample).
 
 Prints one line `mcap ok: ...` and exits 0, or names the first mismatch
 and exits 1.
@@ -49,8 +52,10 @@ def ns(t):
 
 def read_states(path, observer):
     """{time_ns: {frame: row-major matrix}} from the states CSV (estimate
-    frames only with an observer: the CSV has R_hat columns either way)."""
+    frames only with an observer: the CSV has R_hat columns either way),
+    and {time_ns: {agent: (tau1, tau2, tau3)}}."""
     states = defaultdict(dict)
+    torques = defaultdict(dict)
     with open(path, newline="") as f:
         for row in csv.DictReader(f):
             t, node = ns(row["t"]), int(row["node"])
@@ -59,10 +64,11 @@ def read_states(path, observer):
                 states[t]["leader"] = r
                 continue
             states[t][f"agent-{node}"] = r
+            torques[t][node] = tuple(float(row[f"tau{i}"]) for i in (1, 2, 3))
             if observer:
                 rh = [float(row[f"r_hat{i}{j}"]) for i in (1, 2, 3) for j in (1, 2, 3)]
                 states[t][f"estimate-{node}"] = rh
-    return states
+    return states, torques
 
 
 def read_errors(path):
@@ -98,6 +104,7 @@ def check_channels(summary, agents):
     topics = {c.topic: c for c in summary.channels.values()}
     expected = {"/tf": "foxglove.FrameTransforms"}
     expected.update({f"/errors/agent-{a}": "attsync.AgentErrors" for a in agents})
+    expected.update({f"/torque/agent-{a}": "attsync.AgentTorque" for a in agents})
     if set(topics) != set(expected):
         fail(f"topics {sorted(topics)}, expected {sorted(expected)}")
     for topic, name in expected.items():
@@ -142,10 +149,22 @@ def check_errors(k, topic, msg, row):
         fail(f"{topic} #{k}: timestamp {stamp} ns, expected {t} ns")
 
 
+def check_torque(k, t, topic, msg, tau):
+    got = (msg.x, msg.y, msg.z)
+    if not all(same(a, b) for a, b in zip(got, tau)):
+        fail(f"{topic} #{k}: {got}, states CSV {tau}")
+    norm = (tau[0] ** 2 + tau[1] ** 2 + tau[2] ** 2) ** 0.5
+    if not (same(msg.norm, norm) or abs(msg.norm - norm) <= TOLERANCE * max(1.0, norm)):
+        fail(f"{topic} #{k}: norm {msg.norm}, of the CSV's torque {norm}")
+    stamp = msg.timestamp.seconds * 1_000_000_000 + msg.timestamp.nanos
+    if stamp != t:
+        fail(f"{topic} #{k}: timestamp {stamp} ns, expected {t} ns")
+
+
 def main(recording, states_csv, errors_csv):
     errors = read_errors(errors_csv)
     observer = any(row[3] is not None for rows in errors.values() for row in rows)
-    states = read_states(states_csv, observer)
+    states, torques = read_states(states_csv, observer)
     times = sorted(states)
     agents = sorted(errors)
     seen = defaultdict(int)
@@ -165,6 +184,8 @@ def main(recording, states_csv, errors_csv):
                 fail(f"{topic} #{k}: log/publish time {message.log_time}/{message.publish_time} ns, sample at {t} ns")
             if topic == "/tf":
                 check_tf(k, t, msg, states[t])
+            elif topic.startswith("/torque/"):
+                check_torque(k, t, topic, msg, torques[t][int(topic.rsplit("-", 1)[1])])
             else:
                 check_errors(k, topic, msg, errors[int(topic.rsplit("-", 1)[1])][k])
     for topic, c in topics.items():

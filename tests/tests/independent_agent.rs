@@ -150,16 +150,45 @@ fn a_timeline_of_events_is_bit_identical() {
 
 #[test]
 fn actuator_limits_are_bit_identical() {
-    // PROTOCOL.md § 10.11: agent 1 saturated by norm, agent 3 per axis.
+    // PROTOCOL.md § 10.11: agent 1 saturated by norm and in rate, agent 3
+    // per axis.
     assert_bit_identical(
         "independent-actuator",
         &paper("timevarying"),
         &[0, 2],
         &[
             DURATION,
-            "actuator={max_torque=0.5}",
+            "actuator={max_torque=0.5, max_torque_rate=4.0}",
             "agent[2].actuator={max_torque=[0.2, 0.3, 0.25]}",
         ],
+    );
+}
+
+#[test]
+fn body_effects_are_bit_identical() {
+    // PROTOCOL.md § 10.12–10.13: every kind of disturbance (one inertial),
+    // noisy biased sensors; without an observer agents 1 and 3 publish what
+    // their sensors measure.
+    let disturbances = concat!(
+        "disturbance=[",
+        "{kind=\"constant\", torque=[0.02, -0.01, 0.03], frame=\"inertial\"},",
+        "{kind=\"sine\", amplitude=[0.05, 0.0, 0.02], frequency=0.7, phase=0.3},",
+        "{kind=\"noise\", std=[0.02, 0.01, 0.03], bandwidth=3.0},",
+        "{kind=\"impulse\", t=1.5, impulse=[0.2, 0.0, -0.1]}]"
+    );
+    let sensor = "sensor={attitude_noise=2e-3, attitude_bias=[0.0, 1e-3, 0.0], rate_noise=1e-3, rate_bias=[5e-4, 0.0, 0.0]}";
+    assert_bit_identical(
+        "independent-effects",
+        &paper("constant-observerless"),
+        &AGENTS_1_AND_3,
+        &[DURATION, disturbances, sensor],
+    );
+    // § 10.14 with sensors under an observer: the law assumes 1.3 J.
+    assert_bit_identical(
+        "independent-mismatch",
+        &paper("timevarying"),
+        &AGENTS_1_AND_3,
+        &[DURATION, sensor, "controller={inertia_scale=1.3}"],
     );
 }
 
@@ -169,6 +198,34 @@ fn the_independent_agent_conforms() {
     let r = conform_python(&tmp, &[], &agent_py());
     r.assert_ok();
     assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
+}
+
+#[test]
+fn conform_checks_the_law_with_body_effects() {
+    // § 10.12–10.13: conform's law rule plays the neighbourhood with the
+    // scenario's effects; the independent agent follows them, the example
+    // plug-in (which ignores them) is caught.
+    let tmp = Sandbox::new("independent-conform-effects");
+    let scenario = tmp.join("effects.toml");
+    let base = std::fs::read_to_string(paper("constant-observerless")).unwrap();
+    let extra = concat!(
+        "\n[[disturbance]]\nkind = \"sine\"\namplitude = [0.05, 0.0, 0.02]\nfrequency = 0.7\n",
+        "\n[[disturbance]]\nkind = \"noise\"\nstd = 0.02\nbandwidth = 2.0\n",
+        "\n[sensor]\nattitude_noise = 0.001\nrate_noise = 0.0005\n"
+    );
+    std::fs::write(&scenario, base + extra).unwrap();
+    let args = [
+        "--scenario".into(),
+        scenario.into_os_string(),
+        "--agent".into(),
+        "3".into(),
+    ];
+    let r = conform_python(&tmp, &args, &agent_py());
+    r.assert_ok();
+    assert!(r.stdout.contains("10/10 rules pass"), "{}", r.describe());
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/python/agent.py");
+    let r = conform_python(&tmp, &args, &example);
+    assert!(r.stdout.contains("FAIL  law"), "{}", r.describe());
 }
 
 #[test]

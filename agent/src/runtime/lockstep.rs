@@ -4,7 +4,9 @@
 //! has arrived, then advances one stage.
 
 use super::hooks::{Hooked, Hooks};
-use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_origin};
+use super::{
+    Inputs, NodeError, Orphan, Stepper, after_stage_0, after_step, before_step, check_origin,
+};
 use crate::wait::Waiter;
 use attitude::schedule::{Schedule, Slot};
 use iceoryx2::prelude::*;
@@ -32,6 +34,9 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
             exchange(io, cfg, stepper, inputs, &mut waiter, slot, orphan)?;
         }
         stepper.advance();
+        if slot.starts_step() {
+            after_stage_0(io, cfg, stepper, slot.step)?;
+        }
         if slot.ends_step() {
             after_step(io, cfg, stepper, slot.step + 1)?;
         }

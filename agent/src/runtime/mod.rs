@@ -70,6 +70,15 @@ pub trait Stepper {
     /// Largest torque norm applied so far, taken at stage 0 of each step
     /// (as the built-in agent does), N·m.
     fn peak_torque(&self) -> f64;
+    /// Telemetry of the torque applied at stage 0 of the current step,
+    /// which is step `step`, just after that stage was evaluated
+    /// ([`Telemetry::Torque`]); the loop reports it at every sampled step
+    /// but the last. `None` (the default: the leader, or a plug-in that
+    /// does not say) reports nothing, and the run records NaN.
+    fn torque(&self, step: u64) -> Option<Telemetry> {
+        let _ = step;
+        None
+    }
     /// Counters of the impaired incoming links: (sender id, stats).
     fn link_stats(&self) -> Vec<(u32, LinkStats)> {
         Vec::new()
@@ -366,6 +375,22 @@ pub(crate) fn before_step(n: u64, shutdown: &AtomicBool, orphan: &Orphan) -> Res
         return Err(NodeError::Stopped(n));
     }
     orphan.poll()
+}
+
+/// After stage 0 of step `n`: report the torque it applied if the step is
+/// sampled (PROTOCOL.md § 6; never at the last step: none follows it).
+pub(crate) fn after_stage_0<S: Service, N: Stepper, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
+    cfg: &NodeConfig,
+    stepper: &N,
+    n: u64,
+) -> Result<(), NodeError> {
+    if n % cfg.sample_every == 0
+        && let Some(torque) = stepper.torque(n)
+    {
+        io.report(torque)?;
+    }
+    Ok(())
 }
 
 /// After a step: check the state against the envelope (PROTOCOL.md § 9),

@@ -167,7 +167,8 @@ impl<S: Service> Ports<S> {
     }
 
     /// Sends a telemetry report of node `id`; an event (anything but a
-    /// sample) also wakes the orchestrator.
+    /// sample or a torque: [`Telemetry::is_sample`]) also wakes the
+    /// orchestrator.
     ///
     /// NOTE: samples are not notified. The orchestrator drains its telemetry
     /// at least every 10 ms anyway (its wait's timeout) and its buffer holds
@@ -180,7 +181,7 @@ impl<S: Service> Ports<S> {
             .send_copy(TelemetryMsg::encode(id, t))
             .map_err(port("telemetry send"))?;
         self.tele_pacer.sent();
-        if !matches!(t, Telemetry::Sample { .. } | Telemetry::LeaderSample { .. }) {
+        if !t.is_sample() {
             let _ = self.orch_notifier.notify();
         }
         Ok(())

@@ -17,7 +17,9 @@
 //! seconds: the real transport and scheduling latency.
 
 use super::hooks::{Hooked, Hooks};
-use super::{Inputs, NodeError, Orphan, Stepper, after_step, before_step, check_origin};
+use super::{
+    Inputs, NodeError, Orphan, Stepper, after_stage_0, after_step, before_step, check_origin,
+};
 use attitude::link::LinkStats;
 use attitude::schedule::{Schedule, Slot};
 use iceoryx2::prelude::*;
@@ -101,6 +103,9 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
             exchange(io, cfg, stepper, inputs, &mut held, slot, clock.factor)?;
         }
         stepper.advance();
+        if slot.starts_step() {
+            after_stage_0(io, cfg, stepper, slot.step)?;
+        }
         if slot.ends_step() {
             after_step(io, cfg, stepper, slot.step + 1)?;
         }

@@ -79,6 +79,18 @@ fn vec3(w: &[f64], at: usize) -> Vector3<f64> {
 /// Words of an [`Exchanged`].
 pub const EXCHANGED: usize = 15;
 
+/// Words of a vector (a torque).
+pub const VECTOR: usize = 3;
+
+impl Words<VECTOR> for Vector3<f64> {
+    fn to_words(&self) -> [f64; VECTOR] {
+        [self.x, self.y, self.z]
+    }
+    fn from_words(w: &[f64; VECTOR]) -> Self {
+        vec3(w, 0)
+    }
+}
+
 impl Words<1> for f64 {
     fn to_words(&self) -> [f64; 1] {
         [*self]

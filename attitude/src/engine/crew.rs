@@ -12,6 +12,10 @@
 //! go-ahead (the caller is done with them, or says stop). At a sample with
 //! per-agent work ([`super::InProcess::run_with`]) one more: each thread
 //! does its share's work, then the caller takes every share's results.
+//! At a sample before the last step, after the go-ahead, every thread
+//! evaluates stage 0 of the sampled step and leaves its agents' torques on
+//! the board ([`Share::begin`]); a barrier, then the caller samples and
+//! gives a second go-ahead, and the step goes on from stage 1.
 //!
 //! Every agent does exactly the arithmetic of the one-thread loop, on the
 //! same values in the same order, so the trajectories are bit-identical
@@ -19,13 +23,14 @@
 
 use super::PerAgent;
 use super::barrier::SpinBarrier;
-use super::board::{AGENT_STATE, EXCHANGED, JUDGED, Judged, Lined, Slot as Shared, slots};
+use super::board::{AGENT_STATE, EXCHANGED, JUDGED, Judged, Lined, Slot as Shared, VECTOR, slots};
 use super::pass::{Stage, pass};
 use crate::agent::Agent;
 use crate::guard::{Envelope, Violation};
 use crate::network::{AgentState, Exchanged};
 use crate::reference::{Leader, LeaderState};
 use crate::schedule::{Schedule, Slot};
+use nalgebra::Vector3;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering::SeqCst};
 
@@ -41,6 +46,8 @@ pub(super) struct Board {
     states: Vec<Shared<AGENT_STATE>>,
     /// Every agent's peak torque at the end of the last sampled step.
     peaks: Vec<Shared<1>>,
+    /// Every agent's torque at stage 0 of the last sampled step.
+    torques: Vec<Shared<VECTOR>>,
     /// The leader's state at the end of the last sampled step.
     leader: Shared<EXCHANGED>,
     /// Per share, the first agent (network index) outside the envelope
@@ -66,6 +73,7 @@ impl Board {
             }),
             states: slots(agents),
             peaks: slots(agents),
+            torques: slots(agents),
             leader: Shared::default(),
             found: (0..threads).map(|_| Mutex::new(None)).collect(),
             barrier: SpinBarrier::new(threads),
@@ -141,7 +149,8 @@ impl<'a> Share<'a> {
     }
 
     /// Steps this share's agents (and the leader, on the thread that has
-    /// it) through step `n`, one [`pass`] per stage, then leaves on the
+    /// it) through step `n` from stage `skip` (1: stage 0 was evaluated by
+    /// [`Share::begin`]), one [`pass`] per stage, then leaves on the
     /// board what the caller reads (the first agent outside the envelope;
     /// states and peak torques if the step is sampled) and waits for every
     /// thread (the step's end).
@@ -149,12 +158,46 @@ impl<'a> Share<'a> {
         &mut self,
         board: &Board,
         plan: Plan<'_>,
-        n: u64,
+        (n, skip): (u64, usize),
         leader: Option<&mut Leader>,
     ) {
         let mut leader = leader;
+        let stages = plan.schedule.stages(n).skip(skip);
+        let found = self.stages(board, plan, stages, leader.as_deref_mut());
+        self.leave(board, plan.sample_due(n + 1), found, leader.as_deref());
+        board.barrier.wait();
+    }
+
+    /// Evaluates stage 0 of step `n` for this share's agents (and the
+    /// leader, on the thread that has it), leaves their torques on the
+    /// board and waits for every thread: a sample's torques.
+    pub(super) fn begin(
+        &mut self,
+        board: &Board,
+        plan: Plan<'_>,
+        n: u64,
+        leader: Option<&mut Leader>,
+    ) {
+        let first = plan.schedule.stages(n).take(1);
+        self.stages(board, plan, first, leader);
+        for (slot, agent) in board.torques[self.first..].iter().zip(self.agents.iter()) {
+            slot.store(&agent.torque());
+        }
+        board.barrier.wait();
+    }
+
+    /// One [`pass`] per stage of `slots` (the leader's too, with the
+    /// thread that has it); the first agent outside the envelope after the
+    /// last of them, if it ends a step.
+    fn stages(
+        &mut self,
+        board: &Board,
+        plan: Plan<'_>,
+        slots: impl Iterator<Item = Slot>,
+        mut leader: Option<&mut Leader>,
+    ) -> Option<(usize, Violation)> {
         let mut found = None;
-        for slot in plan.schedule.stages(n) {
+        for slot in slots {
             let from_leader = slot
                 .exchange
                 .then(|| self.exchange(board, slot, leader.as_deref()));
@@ -191,8 +234,7 @@ impl<'a> Share<'a> {
                 self.ready = Some((x.step, x.stage));
             }
         }
-        self.leave(board, plan.sample_due(n + 1), found, leader.as_deref());
-        board.barrier.wait();
+        found
     }
 
     /// Which published buffer the next exchange reads.
@@ -276,25 +318,40 @@ pub(super) fn has_outputs<T>() -> bool {
     std::mem::size_of::<T>() != 0
 }
 
-/// A worker thread: steps its share from step `from` until the end or
-/// until the caller says stop; at each sample, `work` for its agents into
-/// `out`, then a barrier (the outputs are ready for the caller).
+/// A worker thread: steps its share from step `from.0` (from its stage 1
+/// if `from.1`: stage 0 was evaluated) until the end or until the caller
+/// says stop; at each sample, `work` for its agents into `out`, then a
+/// barrier (the outputs are ready for the caller); at a sample before the
+/// last step, after the go-ahead, stage 0 of the sampled step
+/// ([`Share::begin`]) and a second go-ahead.
 pub(super) fn work<T: Send>(
     mut share: Share<'_>,
     board: &Board,
     plan: Plan<'_>,
-    from: u64,
+    from: (u64, bool),
     (work, out): (&(impl PerAgent<T> + Sync), &Mutex<Vec<T>>),
 ) {
-    for n in from..plan.schedule.steps() {
-        share.step(board, plan, n, None);
-        if plan.sample_due(n + 1) && has_outputs::<T>() {
+    let steps = plan.schedule.steps();
+    let mut skip = usize::from(from.1);
+    for n in from.0..steps {
+        share.step(board, plan, (n, skip), None);
+        skip = 0;
+        let due = plan.sample_due(n + 1);
+        if due && has_outputs::<T>() {
             share.outputs(work, &board.leader.load(), &mut lock(out));
             board.barrier.wait();
         }
         board.barrier.wait();
         if board.stop.load(SeqCst) {
             return;
+        }
+        if due && n + 1 < steps {
+            share.begin(board, plan, n + 1, None);
+            board.barrier.wait();
+            if board.stop.load(SeqCst) {
+                return;
+            }
+            skip = 1;
         }
     }
 }
@@ -334,6 +391,13 @@ pub(super) fn read_states(board: &Board, states: &mut [AgentState]) {
     for (s, slot) in states.iter_mut().zip(&board.states) {
         *s = slot.load();
     }
+}
+
+/// The caller's side after a sample's stage 0 ([`Share::begin`]): every
+/// agent's torque into `torques`.
+pub(super) fn read_torques(board: &Board, torques: &mut Vec<Vector3<f64>>) {
+    torques.clear();
+    torques.extend(board.torques.iter().map(|slot| slot.load::<Vector3<f64>>()));
 }
 
 /// The caller's side after a sampled step's end: every agent's peak torque into `peaks`.

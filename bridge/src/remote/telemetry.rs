@@ -11,9 +11,9 @@ use super::keys;
 use super::link::{LinkReceiver, LinkSender, TELEMETRY_WINDOW};
 use super::local::{LocalNs, Shared};
 use iceoryx2::prelude::*;
+use msgs::TelemetryMsg;
 use msgs::bytes::Bytes;
 use msgs::iox::iox;
-use msgs::{Telemetry, TelemetryMsg};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -184,10 +184,7 @@ fn sink_loop(e: &Ends) -> Result<(), BridgeError> {
         let (id, m) = unframe(&b)?;
         let k = (ids.iter().position(|&i| i == id)).ok_or(BridgeError::NotPlaced(id))?;
         pubs[k].send_copy(m).map_err(iox("telemetry send"))?;
-        let sample = matches!(
-            m.decode(),
-            Ok(Telemetry::Sample { .. } | Telemetry::LeaderSample { .. })
-        );
+        let sample = m.decode().is_ok_and(|t| t.is_sample());
         if !sample {
             let _ = wake.notify();
         }
@@ -199,6 +196,7 @@ fn sink_loop(e: &Ends) -> Result<(), BridgeError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use msgs::Telemetry;
 
     #[test]
     fn a_frame_carries_its_service_id_and_the_exact_message() {

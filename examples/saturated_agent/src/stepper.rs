@@ -38,6 +38,8 @@ pub struct SaturatedAgent {
     tau_max: f64,
     peak_torque: f64,
     peak_demanded: f64,
+    /// The torque applied at stage 0 of the current step.
+    tau0: Vector3<f64>,
     steps: u64,
     saturated_steps: u64,
     /// First and last step that began saturated.
@@ -97,6 +99,7 @@ impl SaturatedAgent {
             tau_max,
             peak_torque: 0.0,
             peak_demanded: 0.0,
+            tau0: Vector3::zeros(),
             steps: 0,
             saturated_steps: 0,
             saturated_span: None,
@@ -170,6 +173,7 @@ impl Stepper for SaturatedAgent {
         if self.step.stage() == 0 {
             // As attsync's agent: the peak over step starts.
             self.peak_torque = self.peak_torque.max(tau.norm());
+            self.tau0 = tau;
             self.peak_demanded = self.peak_demanded.max(demanded.norm());
             if tau != demanded {
                 self.saturated_steps += 1;
@@ -197,6 +201,13 @@ impl Stepper for SaturatedAgent {
 
     fn peak_torque(&self) -> f64 {
         self.peak_torque
+    }
+
+    fn torque(&self, step: u64) -> Option<Telemetry> {
+        Some(Telemetry::Torque {
+            step,
+            tau: self.tau0,
+        })
     }
 }
 

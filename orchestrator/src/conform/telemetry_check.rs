@@ -1,5 +1,7 @@
 //! Rule `telemetry`: the candidate's reports, checked as they come — its own
-//! sender id, decodable, samples finite and at the due steps, then `Done`.
+//! sender id, decodable, samples finite and at the due steps, then `Done`;
+//! a torque (optional) only right after the sample of its step, never at
+//! the last step.
 
 use crate::processes::Ports;
 use msgs::Telemetry;
@@ -73,6 +75,14 @@ impl TelemetryCheck {
                 }
                 Ok(Telemetry::LeaderSample { step, .. }) => {
                     bad(format!("sends the leader's sample (step {step})"));
+                }
+                Ok(Telemetry::Torque { step, .. }) => {
+                    if self.seen.last() != Some(&step) || step >= steps || self.done {
+                        bad(format!(
+                            "a torque at step {step} that follows no sample of that step \
+                             (or of the last step)"
+                        ));
+                    }
                 }
                 Ok(Telemetry::Done(d)) => {
                     if d.steps != steps {

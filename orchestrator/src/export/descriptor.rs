@@ -25,6 +25,8 @@ const FRAME_TRANSFORM_FILE: &str = "foxglove/FrameTransform.proto";
 const FRAME_TRANSFORMS_FILE: &str = "foxglove/FrameTransforms.proto";
 /// `attsync/AgentErrors.proto`.
 const AGENT_ERRORS_FILE: &str = "attsync/AgentErrors.proto";
+/// `attsync/AgentTorque.proto`.
+const AGENT_TORQUE_FILE: &str = "attsync/AgentTorque.proto";
 
 /// `.google.protobuf.Timestamp`, the fully qualified name fields refer to.
 const TIMESTAMP: &str = ".google.protobuf.Timestamp";
@@ -33,6 +35,8 @@ const TIMESTAMP: &str = ".google.protobuf.Timestamp";
 pub const FRAME_TRANSFORMS: &str = "foxglove.FrameTransforms";
 /// The schema name of error messages.
 pub const AGENT_ERRORS: &str = "attsync.AgentErrors";
+/// The schema name of torque messages.
+pub const AGENT_TORQUE: &str = "attsync.AgentTorque";
 
 /// A scalar or message field, `optional` (proto3's implicit presence for
 /// scalars) unless `repeated`.
@@ -174,6 +178,23 @@ fn agent_errors_files() -> Vec<FileDescriptorProto> {
     ]
 }
 
+/// attsync's `AgentTorque` (mirrors [`super::proto::AgentTorque`]), with the
+/// timestamp file.
+fn agent_torque_files() -> Vec<FileDescriptorProto> {
+    let mut torque = vec![field("timestamp", 1, Type::Message, Some(TIMESTAMP))];
+    let doubles = ["x", "y", "z", "norm"].into_iter().zip(2..);
+    torque.extend(doubles.map(|(name, n)| field(name, n, Type::Double, None)));
+    vec![
+        timestamp_file(),
+        file(
+            AGENT_TORQUE_FILE,
+            "attsync",
+            &[TIMESTAMP_FILE],
+            vec![message("AgentTorque", torque)],
+        ),
+    ]
+}
+
 /// The serialized `FileDescriptorSet` of `foxglove.FrameTransforms`.
 #[must_use]
 pub fn frame_transforms() -> Vec<u8> {
@@ -188,6 +209,15 @@ pub fn frame_transforms() -> Vec<u8> {
 pub fn agent_errors() -> Vec<u8> {
     FileDescriptorSet {
         file: agent_errors_files(),
+    }
+    .encode_to_vec()
+}
+
+/// The serialized `FileDescriptorSet` of `attsync.AgentTorque`.
+#[must_use]
+pub fn agent_torque() -> Vec<u8> {
+    FileDescriptorSet {
+        file: agent_torque_files(),
     }
     .encode_to_vec()
 }
@@ -224,6 +254,7 @@ mod tests {
     fn both_sets_are_self_contained() {
         assert_self_contained(&frame_transforms_files());
         assert_self_contained(&agent_errors_files());
+        assert_self_contained(&agent_torque_files());
     }
 
     #[test]
@@ -231,6 +262,7 @@ mod tests {
         for (bytes, schema) in [
             (frame_transforms(), FRAME_TRANSFORMS),
             (agent_errors(), AGENT_ERRORS),
+            (agent_torque(), AGENT_TORQUE),
         ] {
             let set = FileDescriptorSet::decode(bytes.as_slice()).unwrap();
             let (package, name) = schema.split_once('.').unwrap();

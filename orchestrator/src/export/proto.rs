@@ -1,6 +1,6 @@
 //! The Protobuf messages of a recording, as Rust structs (prost's derive):
 //! Foxglove's well-known `foxglove.FrameTransforms` (and the messages it is
-//! made of) and attsync's own `attsync.AgentErrors`.
+//! made of) and attsync's own `attsync.AgentErrors` and `attsync.AgentTorque`.
 //!
 //! Each struct here has its twin in [`super::descriptor`], which describes the
 //! same message (names, field numbers, types) to readers that know nothing of
@@ -102,4 +102,27 @@ pub struct AgentErrors {
     /// confused with an error of 0.
     #[prost(message, optional, tag = "4")]
     pub observer: Option<ObserverErrors>,
+}
+
+/// `attsync.AgentTorque`: the torque `τᵢ` one agent applied at stage 0 of
+/// the sample's step (after its actuator's limits), N·m, body frame, and
+/// its norm: the `tau` of its `states.bin` record, NaN at the last sample
+/// (no torque follows the last step).
+#[derive(Clone, PartialEq, prost::Message)]
+pub struct AgentTorque {
+    /// The sample's simulated time (field 1).
+    #[prost(message, optional, tag = "1")]
+    pub timestamp: Option<Timestamp>,
+    /// `τᵢ` along the body's x axis, N·m (field 2).
+    #[prost(double, tag = "2")]
+    pub x: f64,
+    /// Along y (field 3).
+    #[prost(double, tag = "3")]
+    pub y: f64,
+    /// Along z (field 4).
+    #[prost(double, tag = "4")]
+    pub z: f64,
+    /// `‖τᵢ‖`, N·m (field 5).
+    #[prost(double, tag = "5")]
+    pub norm: f64,
 }

@@ -5,6 +5,8 @@
 //! metadata "attsync"          scenario, dt, sample_every, agents, time = simulated
 //! /tf                         foxglove.FrameTransforms, one message per sample (see `scene`)
 //! /errors/agent-<id>          attsync.AgentErrors, one message per sample, per agent
+//! /torque/agent-<id>          attsync.AgentTorque, one message per sample, per agent
+//!                             (τᵢ at stage 0 of the sample's step; NaN at the last sample)
 //! ```
 //! Every channel has `message_encoding = "protobuf"`, every schema
 //! `encoding = "protobuf"` with a `FileDescriptorSet` ([`super::descriptor`]).
@@ -33,6 +35,12 @@ pub const TF_TOPIC: &str = "/tf";
 #[must_use]
 pub fn errors_topic(id: u32) -> String {
     format!("/errors/{}", node_name(id))
+}
+
+/// `/torque/agent-<id>`: the topic of agent `id`'s torque.
+#[must_use]
+pub fn torque_topic(id: u32) -> String {
+    format!("/torque/{}", node_name(id))
 }
 
 /// Why a recording could not be written.
@@ -64,7 +72,7 @@ pub enum McapExportError {
 pub struct McapSummary {
     /// Samples (records of `states.bin`).
     pub samples: u64,
-    /// Channels: `/tf` and one per agent.
+    /// Channels: `/tf` and two per agent (errors, torque).
     pub channels: usize,
     /// Messages, all channels.
     pub messages: u64,
@@ -74,6 +82,7 @@ pub struct McapSummary {
 struct Channels {
     tf: u16,
     errors: Vec<u16>,
+    torques: Vec<u16>,
 }
 
 /// Writes the recording of `states_file` to `out` (replacing it); on any
@@ -109,7 +118,7 @@ fn write_to(records: states::Records, out: &Path) -> Result<McapSummary, McapExp
     let channels = add_channels(&mut w, &h).map_err(mcap_err)?;
     let mut summary = McapSummary {
         samples: 0,
-        channels: 1 + channels.errors.len(),
+        channels: 1 + channels.errors.len() + channels.torques.len(),
         messages: 0,
     };
     for rec in records {
@@ -141,7 +150,7 @@ fn metadata(h: &Header) -> Metadata {
     }
 }
 
-/// Adds both schemas, `/tf` and one error channel per agent.
+/// Adds the three schemas, `/tf`, and an error and a torque channel per agent.
 fn add_channels<W: Write + io::Seek>(w: &mut Writer<W>, h: &Header) -> mcap::McapResult<Channels> {
     let (protobuf, none) = ("protobuf", BTreeMap::new());
     let tf_schema = w.add_schema(
@@ -154,16 +163,27 @@ fn add_channels<W: Write + io::Seek>(w: &mut Writer<W>, h: &Header) -> mcap::Mca
         protobuf,
         &descriptor::agent_errors(),
     )?;
+    let torque_schema = w.add_schema(
+        descriptor::AGENT_TORQUE,
+        protobuf,
+        &descriptor::agent_torque(),
+    )?;
     let tf = w.add_channel(tf_schema, TF_TOPIC, protobuf, &none)?;
-    let errors = h
-        .agent_ids
-        .iter()
-        .map(|&id| {
-            let meta = BTreeMap::from([("agent".to_string(), id.to_string())]);
-            w.add_channel(errors_schema, &errors_topic(id), protobuf, &meta)
-        })
-        .collect::<mcap::McapResult<_>>()?;
-    Ok(Channels { tf, errors })
+    let mut per_agent = |schema, topic: fn(u32) -> String| {
+        (h.agent_ids.iter())
+            .map(|&id| {
+                let meta = BTreeMap::from([("agent".to_string(), id.to_string())]);
+                w.add_channel(schema, &topic(id), protobuf, &meta)
+            })
+            .collect::<mcap::McapResult<Vec<_>>>()
+    };
+    let errors = per_agent(errors_schema, errors_topic)?;
+    let torques = per_agent(torque_schema, torque_topic)?;
+    Ok(Channels {
+        tf,
+        errors,
+        torques,
+    })
 }
 
 /// Writes one sample's messages (`sequence`: the sample's index, the same
@@ -190,5 +210,9 @@ fn write_sample<W: Write + io::Seek>(
     for (&channel, e) in channels.errors.iter().zip(&errors) {
         w.write_to_known_channel(&header(channel), &e.encode_to_vec())?;
     }
-    Ok(1 + errors.len() as u64)
+    let torques = scene::agent_torques(h, rec);
+    for (&channel, t) in channels.torques.iter().zip(&torques) {
+        w.write_to_known_channel(&header(channel), &t.encode_to_vec())?;
+    }
+    Ok(1 + (errors.len() + torques.len()) as u64)
 }

@@ -1,6 +1,7 @@
 //! The scene of a recording: one coordinate frame per body, placed apart so
 //! that a 3D view shows every attitude at once, and the messages of one
-//! sample ([`transforms`], [`agent_errors`]) stamped with simulated time.
+//! sample ([`transforms`], [`agent_errors`], [`agent_torques`]) stamped
+//! with simulated time.
 //!
 //! # Frames
 //! ```text
@@ -14,7 +15,7 @@
 //! about `SPACING` apart. The positions are a layout for viewing only: the
 //! model has attitudes, not positions.
 
-use super::proto::{AgentErrors, FrameTransform, FrameTransforms, ObserverErrors};
+use super::proto::{AgentErrors, AgentTorque, FrameTransform, FrameTransforms, ObserverErrors};
 use super::proto::{Quaternion, Vector3};
 use crate::results::layout::node_name;
 use crate::results::states::{Header, Record};
@@ -135,6 +136,25 @@ pub fn agent_errors(h: &Header, rec: &Record) -> Vec<AgentErrors> {
                     att_err,
                     angvel_err,
                 }),
+            }
+        })
+        .collect()
+}
+
+/// The torque messages of one record, one per agent in header order: its
+/// `tau` and `‖tau‖` (NaN at the run's last record).
+#[must_use]
+pub fn agent_torques(h: &Header, rec: &Record) -> Vec<AgentTorque> {
+    let ns = time_ns(rec.step, h.dt);
+    (rec.agents.iter())
+        .map(|a| {
+            let [x, y, z] = a.tau;
+            AgentTorque {
+                timestamp: Some(timestamp(ns)),
+                x,
+                y,
+                z,
+                norm: a.torque().norm(),
             }
         })
         .collect()

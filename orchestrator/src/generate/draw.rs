@@ -43,6 +43,8 @@ pub(super) fn random_agent(rng: &mut ChaCha8Rng, id: u32, scheme: SchemeKind) ->
         command: None,
         env: None,
         actuator: None,
+        sensor: None,
+        controller: None,
     }
 }
 

@@ -324,6 +324,7 @@ fn trace_of_run(out: &Path, base: &Base) -> Result<Trace, McError> {
             step: rec.step,
             leader: &rec.leader.state(),
             agents: &agents,
+            torques: &rec.torques(),
         });
     }
     Ok(trace)

@@ -1,17 +1,26 @@
 //! Telemetry collection: one [`NodeSlot`] per node (what it reported so
 //! far), every message checked and booked, samples joined into the same
 //! snapshots the in-process engine produces ([`Session::collect`]).
+//!
+//! An agent's sample of step n waits for its torque of step n (telemetry
+//! `Torque`, sent after stage 0 of step n) before it joins a snapshot. The
+//! torque is optional: a sample whose node reported anything after it
+//! (its next sample, `Done`, `Failed`) without its torque has NaN, as has
+//! every sample of the run's last step (no torque follows it). When the
+//! run fails, the snapshots whose samples all came are still handed out,
+//! missing torques NaN.
 
 use super::startup::POLL;
 use super::{Ports, Session};
 use crate::failure::Failure;
 use crate::outcome::Outcome;
-use attitude::engine::Snapshot;
+use attitude::engine::{NO_TORQUE, Snapshot};
 use attitude::guard::{self, Divergence, Envelope, Violation};
 use attitude::link::LinkStats;
 use attitude::network::AgentState;
 use attitude::reference::LeaderState;
 use msgs::{Done, FailReason, Telemetry, TelemetryMsg};
+use nalgebra::Vector3;
 use std::collections::VecDeque;
 use std::time::{Duration, Instant};
 
@@ -20,9 +29,25 @@ use std::time::{Duration, Instant};
 pub(crate) enum Sampled {
     /// The leader's.
     Leader(LeaderState),
-    /// An agent's, with its peak torque so far.
-    Agent(AgentState, f64),
+    /// An agent's.
+    Agent(AgentSample),
 }
+
+/// An agent's sample: its state, its peak torque so far and, once
+/// reported, its torque at stage 0 of the sample's step.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AgentSample {
+    /// The state at the step's start.
+    pub state: AgentState,
+    /// The largest `‖τᵢ‖` so far, N·m.
+    pub peak_torque: f64,
+    /// `τᵢ` at stage 0 of the step, once reported.
+    pub tau: Option<Vector3<f64>>,
+}
+
+/// A snapshot as the collector assembles it: step, leader, agents and
+/// their torques.
+type Assembled = (u64, LeaderState, Vec<AgentState>, Vec<Vector3<f64>>);
 
 /// What the orchestrator knows of one node (its telemetry subscriber is the
 /// [`Ports`] subscriber of the same index).
@@ -88,6 +113,8 @@ pub(crate) struct Collector {
     pub diverged: Vec<(usize, Divergence)>,
     /// The envelope every sample is checked against.
     pub guard: Envelope,
+    /// The run's steps: the samples of this step have no torque.
+    pub horizon: u64,
 }
 
 impl Collector {
@@ -101,6 +128,7 @@ impl Collector {
             broke_protocol: Vec::new(),
             diverged: Vec::new(),
             guard: Envelope::default(),
+            horizon: u64::MAX,
         }
     }
 
@@ -153,9 +181,15 @@ impl Collector {
                 if self.check_sample(i, step, guard::check_agent(&state, &env))? {
                     let slot = &mut self.slots[i];
                     slot.peak_torque = slot.peak_torque.max(peak_torque);
-                    (slot.pending).push_back((step, Sampled::Agent(state, peak_torque)));
+                    let sample = AgentSample {
+                        state,
+                        peak_torque,
+                        tau: None,
+                    };
+                    (slot.pending).push_back((step, Sampled::Agent(sample)));
                 }
             }
+            Telemetry::Torque { step, tau } => self.take_torque(i, step, tau)?,
             Telemetry::LeaderSample { step, state } => {
                 if self.check_sample(i, step, guard::check_leader(&state, &env))? {
                     self.slots[i]
@@ -172,7 +206,10 @@ impl Collector {
     fn take_report(&mut self, i: usize, t: Telemetry) {
         let slot = &mut self.slots[i];
         match t {
-            Telemetry::Ready | Telemetry::Sample { .. } | Telemetry::LeaderSample { .. } => {}
+            Telemetry::Ready
+            | Telemetry::Sample { .. }
+            | Telemetry::LeaderSample { .. }
+            | Telemetry::Torque { .. } => {}
             Telemetry::LinkStats { from, stats } => self.links.push((from, slot.id, stats)),
             Telemetry::Done(d) => {
                 slot.done = true;
@@ -202,6 +239,41 @@ impl Collector {
                     )),
                 }
             }
+        }
+    }
+
+    /// Books node index `i`'s torque `tau` of step `step` into its sample
+    /// of that step, which must be the last it sent (and not of the run's
+    /// last step); a diverged node's is ignored, as its samples are.
+    fn take_torque(&mut self, i: usize, step: u64, tau: Vector3<f64>) -> Result<(), Failure> {
+        if self.diverged.iter().any(|&(j, _)| j == i) {
+            return Ok(());
+        }
+        let horizon = self.horizon;
+        match self.slots[i].pending.back_mut() {
+            Some((s, Sampled::Agent(a))) if *s == step && a.tau.is_none() && step < horizon => {
+                a.tau = Some(tau);
+                Ok(())
+            }
+            _ => Err(self.sent_garbage(
+                i,
+                &format!("of a torque at step {step} that follows no sample of that step"),
+            )),
+        }
+    }
+
+    /// Whether the first pending sample of `slot` may join a snapshot: the
+    /// leader's at once; an agent's once its torque came, or anything after
+    /// it (its torque will not come), or at the run's last step; any if
+    /// `flush` (the run failed: no more will come).
+    fn settled(&self, slot: &NodeSlot, flush: bool) -> bool {
+        match slot.pending.front() {
+            Some((step, Sampled::Agent(a))) => {
+                let later = slot.pending.len() > 1 || slot.done || slot.gave_up;
+                flush || later || a.tau.is_some() || *step >= self.horizon
+            }
+            Some((_, Sampled::Leader(_))) => true,
+            None => false,
         }
     }
 
@@ -259,11 +331,8 @@ impl Collector {
     }
 
     /// The next complete snapshot before step `before`, if every node has
-    /// sent it.
-    fn next_snapshot(
-        &mut self,
-        before: u64,
-    ) -> Result<Option<(u64, LeaderState, Vec<AgentState>)>, Failure> {
+    /// sent it (and every agent its torque: [`Collector::settled`]).
+    fn next_snapshot(&mut self, before: u64, flush: bool) -> Result<Option<Assembled>, Failure> {
         if self.slots.iter().any(|s| s.pending.is_empty()) {
             return Ok(None);
         }
@@ -278,23 +347,30 @@ impl Collector {
                 leader: step,
             });
         }
+        if !self.slots.iter().all(|s| self.settled(s, flush)) {
+            return Ok(None);
+        }
+        let horizon = self.horizon;
         let mut samples = (self.slots.iter_mut()).map(|s| {
             let sample = s.pending.pop_front().expect("non-empty").1;
-            if let Sampled::Agent(_, peak) = sample {
-                s.snapshot_peak_torque = peak;
+            if let Sampled::Agent(a) = sample {
+                s.snapshot_peak_torque = a.peak_torque;
             }
             (s.name.as_str(), sample)
         });
         let Some((_, Sampled::Leader(leader))) = samples.next() else {
             return Err(Failure::LeaderSentAgentSample);
         };
-        let agents = samples
+        let (agents, torques) = samples
             .map(|(name, s)| match s {
-                Sampled::Agent(a, _) => Ok(a),
+                Sampled::Agent(a) if step < horizon => Ok((a.state, a.tau.unwrap_or(NO_TORQUE))),
+                Sampled::Agent(a) => Ok((a.state, NO_TORQUE)),
                 Sampled::Leader(_) => Err(Failure::AgentSentLeaderSample(name.to_string())),
             })
-            .collect::<Result<_, _>>()?;
-        Ok(Some((step, leader, agents)))
+            .collect::<Result<Vec<_>, _>>()?
+            .into_iter()
+            .unzip();
+        Ok(Some((step, leader, agents, torques)))
     }
 
     /// What the run produced, ending with `failure` (if it failed).
@@ -328,32 +404,61 @@ impl Collector {
 impl Session<'_> {
     /// Collects telemetry into snapshots, handing each to `on_sample`, until
     /// every node is done; fails when a node fails, on an interrupt, or when
-    /// no telemetry came for twice the stage timeout.
+    /// no telemetry came for twice the stage timeout (then the snapshots
+    /// whose samples all came are handed out first, missing torques NaN).
     pub(super) fn collect(
+        &mut self,
+        on_sample: &mut impl FnMut(&Snapshot<'_>) -> bool,
+    ) -> Result<(), Failure> {
+        self.nodes.guard = self.net.guard;
+        self.nodes.horizon = self.net.steps;
+        let collected = self.collect_until_done(on_sample);
+        if let Err(f) = &collected
+            && !matches!(f, Failure::WriterStopped)
+        {
+            // Best effort: the run has failed already.
+            let _ = self.hand_out(on_sample, true);
+        }
+        collected
+    }
+
+    /// Hands every complete snapshot before the divergence (if any) to
+    /// `on_sample`; `flush`: without waiting for missing torques.
+    fn hand_out(
+        &mut self,
+        on_sample: &mut impl FnMut(&Snapshot<'_>) -> bool,
+        flush: bool,
+    ) -> Result<(), Failure> {
+        let before = self.nodes.divergence().map_or(u64::MAX, |d| d.step);
+        while let Some((step, leader, agents, torques)) = self.nodes.next_snapshot(before, flush)? {
+            self.nodes.steps = step;
+            let snap = Snapshot {
+                step,
+                leader: &leader,
+                agents: &agents,
+                torques: &torques,
+            };
+            if !on_sample(&snap) {
+                return Err(Failure::WriterStopped);
+            }
+        }
+        Ok(())
+    }
+
+    /// [`Session::collect`] without the last hand-out of a failed run.
+    fn collect_until_done(
         &mut self,
         on_sample: &mut impl FnMut(&Snapshot<'_>) -> bool,
     ) -> Result<(), Failure> {
         let stall = Duration::from_secs_f64(self.opts.stage_timeout * 2.0);
         let mut last_progress = Instant::now();
         let mut diverging: Option<Instant> = None;
-        self.nodes.guard = self.net.guard;
         loop {
             self.ports.wait(POLL);
             if self.nodes.drain(&self.ports)? {
                 last_progress = Instant::now();
             }
-            let before = self.nodes.divergence().map_or(u64::MAX, |d| d.step);
-            while let Some((step, leader, agents)) = self.nodes.next_snapshot(before)? {
-                self.nodes.steps = step;
-                let snap = Snapshot {
-                    step,
-                    leader: &leader,
-                    agents: &agents,
-                };
-                if !on_sample(&snap) {
-                    return Err(Failure::WriterStopped);
-                }
-            }
+            self.hand_out(on_sample, false)?;
             if !self.nodes.diverged.is_empty() {
                 // Every node finishes the step (a diverged node keeps its
                 // ports) and reports its own divergence: wait until they
@@ -439,6 +544,77 @@ mod tests {
             peak_torque: 1.0,
         };
         TelemetryMsg::encode(3, &t)
+    }
+
+    fn leader_sample(step: u64) -> TelemetryMsg {
+        let state = LeaderState {
+            r0: nalgebra::Matrix3::identity(),
+            w0: nalgebra::Vector3::zeros(),
+            s0: nalgebra::Vector3::zeros(),
+        };
+        TelemetryMsg::encode(0, &Telemetry::LeaderSample { step, state })
+    }
+
+    fn torque(step: u64, x: f64) -> TelemetryMsg {
+        let tau = Vector3::new(x, -x, 0.5);
+        TelemetryMsg::encode(3, &Telemetry::Torque { step, tau })
+    }
+
+    /// A collector of a run of `horizon` steps, the leader's samples at
+    /// `steps` booked.
+    fn running(horizon: u64, steps: &[u64]) -> Collector {
+        let mut c = two_nodes();
+        c.horizon = horizon;
+        for &s in steps {
+            c.accept(0, &leader_sample(s)).expect("the leader's sample");
+        }
+        c
+    }
+
+    #[test]
+    fn a_sample_waits_for_its_torque_then_carries_it() {
+        let mut c = running(20, &[0, 10, 20]);
+        c.accept(1, &sample(0, 1.0, 1.0)).expect("a sample");
+        assert!(c.next_snapshot(u64::MAX, false).unwrap().is_none());
+        c.accept(1, &torque(0, 0.25)).expect("its torque");
+        let (step, _, _, torques) = c.next_snapshot(u64::MAX, false).unwrap().unwrap();
+        assert_eq!((step, torques), (0, vec![Vector3::new(0.25, -0.25, 0.5)]));
+        // The last step's sample needs none, and has none.
+        c.accept(1, &sample(10, 1.0, 1.0)).expect("a sample");
+        c.accept(1, &torque(10, 1.0)).expect("its torque");
+        c.accept(1, &sample(20, 1.0, 1.0)).expect("the last sample");
+        assert!(c.next_snapshot(u64::MAX, false).unwrap().is_some());
+        let (step, _, _, torques) = c.next_snapshot(u64::MAX, false).unwrap().unwrap();
+        assert_eq!(step, 20);
+        assert!(torques[0].iter().all(|x| x.is_nan()));
+    }
+
+    #[test]
+    fn a_node_that_reports_no_torque_has_nan_once_it_reports_more() {
+        let mut c = running(20, &[0, 10]);
+        c.accept(1, &sample(0, 1.0, 1.0)).expect("a sample");
+        assert!(c.next_snapshot(u64::MAX, false).unwrap().is_none());
+        c.accept(1, &sample(10, 1.0, 1.0)).expect("the next sample");
+        let (step, _, _, torques) = c.next_snapshot(u64::MAX, false).unwrap().unwrap();
+        assert_eq!(step, 0);
+        assert!(torques[0].iter().all(|x| x.is_nan()));
+        // A failed run hands out what it has, without waiting.
+        assert!(c.next_snapshot(u64::MAX, false).unwrap().is_none());
+        assert!(c.next_snapshot(u64::MAX, true).unwrap().is_some());
+    }
+
+    #[test]
+    fn a_torque_without_its_sample_fails_naming_the_node() {
+        let mut c = running(20, &[0]);
+        c.accept(1, &sample(0, 1.0, 1.0)).expect("a sample");
+        let e = c
+            .accept(1, &torque(10, 1.0))
+            .expect_err("no sample of step 10");
+        assert!(
+            e.to_string()
+                .starts_with("agent-3 (plug-in `x`) broke the protocol")
+        );
+        assert!(e.to_string().contains("torque at step 10"), "{e}");
     }
 
     #[test]

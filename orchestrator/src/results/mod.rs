@@ -37,6 +37,7 @@ use attitude::metrics::{Errors, errors};
 use attitude::network::{AgentState, Network};
 use attitude::reference::LeaderState;
 pub use layout::{RunLayout, SweepLayout};
+use nalgebra::Vector3;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -60,6 +61,9 @@ pub struct Series {
     pub obs_att: Vec<f64>,
     /// Observer angular-velocity errors.
     pub obs_angvel: Vec<f64>,
+    /// `‖τᵢ‖` at stage 0 of each sampled step, N·m (NaN at the last step:
+    /// no torque follows it; NaN where the agent did not report it).
+    pub torque: Vec<f64>,
 }
 
 /// A results file could not be written (a full disk, a read-only directory).
@@ -207,8 +211,29 @@ impl Recorder {
     /// network order, by [`Recorder::row_maker`]).
     pub fn record_rows(&mut self, snap: &Snapshot<'_>, rows: &[Row]) -> Result<(), WriteError> {
         (self.states.write(snap)).map_err(writing(&self.files.states()))?;
+        self.record_torques(snap.torques);
         self.record_errors(snap.step, rows)
             .map_err(writing(&self.files.errors_csv()))
+    }
+
+    /// Every agent's `‖τᵢ‖` of a sample into its series (NaN where missing).
+    fn record_torques(&mut self, torques: &[Vector3<f64>]) {
+        for (k, s) in self.series.iter_mut().enumerate() {
+            s.torque.push(torques.get(k).map_or(f64::NAN, |t| t.norm()));
+        }
+    }
+
+    /// Sets the torques of the last sample, if it is of step `step` (a run
+    /// extended past its horizon: its former last sample had none,
+    /// [`attitude::engine::InProcess::begin_step`]).
+    pub fn amend_torques(&mut self, step: u64, torques: &[Vector3<f64>]) {
+        if self.states.amend_torques(step, torques) {
+            for (s, t) in self.series.iter_mut().zip(torques) {
+                if let Some(last) = s.torque.last_mut() {
+                    *last = t.norm();
+                }
+            }
+        }
     }
 
     /// The `errors.csv` rows and series samples of step `step`.

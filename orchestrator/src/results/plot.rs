@@ -1,7 +1,9 @@
 //! `errors.svg`: attitude and angular-velocity errors per agent against
 //! time, log scale, like the paper's figures (Section `simulation`); where
 //! the scheme has an observer, its errors `|R̂ᵢ R₀ᵀ|_I` and `‖ω̂ᵢ − ω₀‖` in
-//! two more panels; in real-time runs, the age of information of every
+//! two more panels; on request (`[output] torque_plot = true`), the torque
+//! each agent applied, `‖τᵢ‖`, in a third panel after the first two (the
+//! samples with a torque: not the last); in real-time runs, the age of information of every
 //! link (mean and largest, as `summary.json` `links[]` has them: the runs
 //! record no time series of it). A network of more than
 //! [`EACH_AGENT_UP_TO`] agents is drawn as the band of its agents' errors,
@@ -41,6 +43,8 @@ pub const OBSERVER_ATT: &str = "observer attitude error |Rhat_i R_0^T|_I";
 pub const OBSERVER_ANGVEL: &str = "observer angular velocity error ||what_i - w_0|| (rad/s)";
 /// Caption of the age-of-information panel.
 pub const AOI: &str = "age of information per link (ms): mean and max";
+/// Caption of the torque panel (drawn on request).
+pub const TORQUE: &str = "applied torque ‖τᵢ‖ (N·m)";
 
 /// A moment marked on every time axis: a vertical line, labelled in the
 /// first panel (a scenario's `[[event]]`).
@@ -54,17 +58,19 @@ pub struct Mark {
 
 /// Draws the panels into `file` (SVG): the errors of `series` (and their
 /// observer errors where they have them) with `marks` on their time axes,
-/// and the age of information of `aoi` (real-time runs' links; empty: no
-/// such panel).
+/// their torques if `torque`, and the age of information of `aoi`
+/// (real-time runs' links; empty: no such panel).
 pub fn draw(
     file: &Path,
     title: &str,
     series: &[Series],
     aoi: &[LinkSummary],
     marks: &[Mark],
+    torque: bool,
 ) -> Result<(), PlotError> {
     let observer = series.iter().any(|s| !s.obs_att.is_empty());
-    let panels = 2 + if observer { 2 } else { 0 } + usize::from(!aoi.is_empty());
+    let panels =
+        2 + usize::from(torque) + if observer { 2 } else { 0 } + usize::from(!aoi.is_empty());
     let root = canvas(file, (1000, PANEL_HEIGHT * panels as u32), title)?;
     let areas = root.split_evenly((panels, 1));
     let labelled = (marks, true);
@@ -78,9 +84,17 @@ pub fn draw(
     )?;
     let angvel = "angular velocity error ||w_i - w_0|| (rad/s)";
     panel(&areas[1], angvel, series, unlabelled, |s| &s.angvel)?;
+    let mut next = 2;
+    if torque {
+        let torques = (&torques(series)[..], t_end(series));
+        panel_until(&areas[next], TORQUE, torques, unlabelled, |s| &s.att)?;
+        next += 1;
+    }
     if observer {
-        panel(&areas[2], OBSERVER_ATT, series, unlabelled, |s| &s.obs_att)?;
-        panel(&areas[3], OBSERVER_ANGVEL, series, unlabelled, |s| {
+        panel(&areas[next], OBSERVER_ATT, series, unlabelled, |s| {
+            &s.obs_att
+        })?;
+        panel(&areas[next + 1], OBSERVER_ANGVEL, series, unlabelled, |s| {
             &s.obs_angvel
         })?;
     }
@@ -88,6 +102,26 @@ pub fn draw(
         aoi_bars(area, aoi)?;
     }
     root.present().map_err(PlotError::of)
+}
+
+/// Every agent's torque norms as the `att` of a series of its own, at the
+/// samples that have one (not the last: no torque follows it).
+fn torques(series: &[Series]) -> Vec<Series> {
+    let with = |s: &Series| -> (Vec<f64>, Vec<f64>) {
+        let points = s.t.iter().zip(&s.torque).filter(|(_, x)| x.is_finite());
+        points.map(|(t, x)| (*t, *x)).unzip()
+    };
+    (series.iter())
+        .map(|s| {
+            let (t, att) = with(s);
+            Series {
+                id: s.id,
+                t,
+                att,
+                ..Series::default()
+            }
+        })
+        .collect()
 }
 
 /// The mean and largest age of information of each link, as bars (ms).
@@ -137,18 +171,33 @@ fn aoi_bars<DB: DrawingBackend>(
     legend(&mut chart, SeriesLabelPosition::UpperRight)
 }
 
+/// The last sample time of `series` (at least 1 ns: an axis needs a length).
+fn t_end(series: &[Series]) -> f64 {
+    series
+        .iter()
+        .filter_map(|s| s.t.last().copied())
+        .fold(0.0_f64, f64::max)
+        .max(1e-9)
+}
+
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     label: &str,
     series: &[Series],
+    marks: (&[Mark], bool),
+    pick: impl Fn(&Series) -> &[f64],
+) -> Result<(), PlotError> {
+    panel_until(area, label, (series, t_end(series)), marks, pick)
+}
+
+/// [`panel`] with a time axis to `t_end`.
+fn panel_until<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    label: &str,
+    (series, t_end): (&[Series], f64),
     (marks, labelled): (&[Mark], bool),
     pick: impl Fn(&Series) -> &[f64],
 ) -> Result<(), PlotError> {
-    let t_end = series
-        .iter()
-        .filter_map(|s| s.t.last().copied())
-        .fold(0.0_f64, f64::max)
-        .max(1e-9);
     let values = series.iter().flat_map(|s| pick(s).iter().copied());
     let (lo, hi) = values
         .filter(|v| v.is_finite())
@@ -361,15 +410,41 @@ mod tests {
                 angvel: e.clone(),
                 obs_att: if observer { e.clone() } else { Vec::new() },
                 obs_angvel: if observer { e.clone() } else { Vec::new() },
+                torque: Vec::new(),
             })
             .collect()
     }
 
     fn svg(series: &[Series], aoi: &[LinkSummary]) -> String {
+        svg_with(series, aoi, false)
+    }
+
+    fn svg_with(series: &[Series], aoi: &[LinkSummary], torque: bool) -> String {
         let tmp = tempfile::tempdir().expect("tempdir");
         let file = tmp.path().join("errors.svg");
-        draw(&file, "t", series, aoi, &[]).expect("drawn");
+        draw(&file, "t", series, aoi, &[], torque).expect("drawn");
         std::fs::read_to_string(file).expect("written")
+    }
+
+    #[test]
+    fn the_torque_panel_is_drawn_on_request_without_the_last_nan() {
+        let mut with = series(true);
+        for s in &mut with {
+            s.torque = vec![2.0, 0.5, f64::NAN];
+        }
+        let text = svg_with(&with, &[], true);
+        assert!(text.contains(TORQUE) && text.contains(OBSERVER_ATT));
+        assert!(!svg(&with, &[]).contains(TORQUE));
+        assert_eq!(
+            svg(&with, &[]),
+            svg(&series(true), &[]),
+            "torques drawn only on request"
+        );
+        let kept = torques(&with);
+        assert_eq!(
+            (kept[0].t.clone(), kept[0].att.clone()),
+            (vec![0.0, 1.0], vec![2.0, 0.5])
+        );
     }
 
     #[test]

@@ -1,26 +1,37 @@
 //! `states.bin`: the full state trajectory of a run, leader and every agent
 //! at every output sample, as a bincode stream.
 //!
-//! # Layout (version 1)
+//! # Layout (version 2)
 //! bincode 2, fixed-width little-endian integers
 //! (`config::standard().with_fixed_int_encoding()`): `u32`/`u64` are 4/8
 //! bytes LE, `f64` 8 bytes LE, `bool` 1 byte, a `Vec`/`String` is a `u64`
 //! length then its elements, fixed-size arrays have no length.
 //! ```text
-//! Header  { magic: [u8; 8] = "ATTSYNCS", version: u32 = 1, scenario: String,
+//! Header  { magic: [u8; 8] = "ATTSYNCS", version: u32 = 2, scenario: String,
 //!           dt: f64, sample_every: u64, agent_ids: Vec<u32>, has_observer: bool }
 //! Record* { step: u64, leader: Leader, agents: [Agent; agent_ids.len()] (as a Vec) }
 //! Leader  { r0: [f64; 9], w0: [f64; 3], s0: [f64; 3] }
-//! Agent   { r: [f64; 9], w: [f64; 3], r_hat: [f64; 9], w_hat: [f64; 3], s_hat: [f64; 3] }
+//! Agent   { r: [f64; 9], w: [f64; 3], r_hat: [f64; 9], w_hat: [f64; 3], s_hat: [f64; 3],
+//!           tau: [f64; 3] }
 //! ```
 //! Matrices are row-major, attitudes map body to inertial, rates are in the
-//! body frame (rad/s, rad/s²); t = step · dt. Records follow until the end of
-//! the file. Both engines write identical files.
+//! body frame (rad/s, rad/s²); t = step · dt. `tau` is the torque τᵢ the
+//! body received at stage 0 of the record's step (t = step · dt, from the
+//! record's state; after the actuator's limits), N·m, body frame. No torque
+//! is applied after the last step, so the run's last record (step = the
+//! run's steps) has `tau` = NaN; so has an agent that did not report it (a
+//! plug-in that does not send telemetry kind 7, PROTOCOL.md § 5). Records
+//! follow until the end of the file. Both engines write identical files.
+//!
+//! Version 1 is version 2 without `tau` (27 `f64` per agent, not 30): it is
+//! still read, its records with `tau` = NaN, so that older results stay
+//! readable (`verify`, `export`, `view`, `mc --trial`).
 
-use attitude::engine::Snapshot;
+use attitude::engine::{NO_TORQUE, Snapshot};
 use attitude::network::{AgentState, Network};
 use attitude::reference::LeaderState;
 use msgs::{from_rows, to_rows};
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, Read, Write};
@@ -28,8 +39,21 @@ use std::path::Path;
 
 /// File magic.
 pub const MAGIC: [u8; 8] = *b"ATTSYNCS";
-/// Layout version.
-pub const VERSION: u32 = 1;
+/// Layout version (the one written; [`OLDEST_VERSION`] up to it are read).
+pub const VERSION: u32 = 2;
+
+/// The oldest layout version read: version 1 has no torques.
+pub const OLDEST_VERSION: u32 = 1;
+
+/// `f64` words of the leader in a record.
+const LEADER_WORDS: u64 = 9 + 3 + 3;
+
+/// `f64` words of an agent in a record of layout `version` (version 1 has
+/// no `tau`).
+fn agent_words(version: u32) -> u64 {
+    let state = 9 + 3 + 9 + 3 + 3;
+    if version == 1 { state } else { state + 3 }
+}
 
 fn config() -> impl bincode::config::Config {
     bincode::config::standard().with_fixed_int_encoding()
@@ -88,6 +112,46 @@ pub struct AgentRecord {
     pub w_hat: [f64; 3],
     /// `σ̂ᵢ`.
     pub s_hat: [f64; 3],
+    /// `τᵢ` at stage 0 of the record's step, N·m, body frame; NaN at the
+    /// run's last step (none is applied after it) or where not reported.
+    pub tau: [f64; 3],
+}
+
+/// An agent in a record of layout version 1 (no torque).
+#[derive(Debug, Clone, Copy, Deserialize)]
+struct AgentRecordV1 {
+    r: [f64; 9],
+    w: [f64; 3],
+    r_hat: [f64; 9],
+    w_hat: [f64; 3],
+    s_hat: [f64; 3],
+}
+
+/// A record of layout version 1.
+#[derive(Debug, Clone, Deserialize)]
+struct RecordV1 {
+    step: u64,
+    leader: LeaderRecord,
+    agents: Vec<AgentRecordV1>,
+}
+
+impl From<RecordV1> for Record {
+    /// The record with its torques NaN (version 1 has none).
+    fn from(v: RecordV1) -> Self {
+        let agent = |a: AgentRecordV1| AgentRecord {
+            r: a.r,
+            w: a.w,
+            r_hat: a.r_hat,
+            w_hat: a.w_hat,
+            s_hat: a.s_hat,
+            tau: NO_TORQUE.into(),
+        };
+        Self {
+            step: v.step,
+            leader: v.leader,
+            agents: v.agents.into_iter().map(agent).collect(),
+        }
+    }
 }
 
 /// One sample of the whole network.
@@ -114,21 +178,41 @@ impl LeaderRecord {
 }
 
 impl AgentRecord {
-    fn of(x: &AgentState) -> Self {
+    /// The record of state `x` and torque `tau` (`None`: NaN).
+    fn of(x: &AgentState, tau: Option<&Vector3<f64>>) -> Self {
         Self {
             r: to_rows(&x.r),
             w: x.w.into(),
             r_hat: to_rows(&x.r_hat),
             w_hat: x.w_hat.into(),
             s_hat: x.s_hat.into(),
+            tau: (*tau.unwrap_or(&NO_TORQUE)).into(),
         }
+    }
+
+    /// The torque `τᵢ`.
+    #[must_use]
+    pub fn torque(&self) -> Vector3<f64> {
+        self.tau.into()
     }
 }
 
-/// Writes `states.bin` record by record.
+impl Record {
+    /// Every agent's torque, in header order (for a [`Snapshot`]).
+    #[must_use]
+    pub fn torques(&self) -> Vec<Vector3<f64>> {
+        self.agents.iter().map(AgentRecord::torque).collect()
+    }
+}
+
+/// Writes `states.bin` record by record, the last one held back until the
+/// next comes or the file is finished, so that a run extended past its
+/// horizon can complete that record's torques ([`StatesWriter::amend_torques`]).
 #[derive(Debug)]
 pub struct StatesWriter {
     w: BufWriter<File>,
+    /// The last record, not written yet.
+    held: Option<Record>,
 }
 
 /// An encoding error as the I/O error it is (a full disk says
@@ -157,22 +241,49 @@ impl StatesWriter {
                 .is_some_and(|a| a.model.scheme.has_observer()),
         };
         bincode::serde::encode_into_std_write(&header, &mut w, config()).map_err(enc)?;
-        Ok(Self { w })
+        Ok(Self { w, held: None })
     }
 
-    /// Appends one snapshot.
+    /// Appends one snapshot (written once the next one comes, or at
+    /// [`StatesWriter::finish`]).
     pub fn write(&mut self, snap: &Snapshot<'_>) -> io::Result<()> {
+        let agents = snap.agents.iter().enumerate();
         let rec = Record {
             step: snap.step,
             leader: LeaderRecord::of(snap.leader),
-            agents: snap.agents.iter().map(AgentRecord::of).collect(),
+            agents: agents
+                .map(|(k, x)| AgentRecord::of(x, snap.torques.get(k)))
+                .collect(),
         };
-        bincode::serde::encode_into_std_write(&rec, &mut self.w, config()).map_err(enc)?;
+        self.flush_held()?;
+        self.held = Some(rec);
         Ok(())
     }
 
-    /// Flushes the file.
+    /// Sets the torques of the last record, if it is of step `step`; whether
+    /// it was. What a run extended past its horizon does: its former last
+    /// record had none (`attitude::engine::InProcess::begin_step`).
+    pub fn amend_torques(&mut self, step: u64, torques: &[Vector3<f64>]) -> bool {
+        let Some(rec) = self.held.as_mut().filter(|r| r.step == step) else {
+            return false;
+        };
+        for (k, a) in rec.agents.iter_mut().enumerate() {
+            a.tau = (*torques.get(k).unwrap_or(&NO_TORQUE)).into();
+        }
+        true
+    }
+
+    /// Writes the record held back, if any.
+    fn flush_held(&mut self) -> io::Result<()> {
+        if let Some(rec) = self.held.take() {
+            bincode::serde::encode_into_std_write(&rec, &mut self.w, config()).map_err(enc)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the last record and flushes the file.
     pub fn finish(mut self) -> io::Result<()> {
+        self.flush_held()?;
         self.w.flush()
     }
 }
@@ -206,13 +317,14 @@ pub fn open(file: &Path) -> Result<Records, StatesError> {
     if header.magic != MAGIC {
         return Err(what(StatesProblem::BadMagic));
     }
-    if header.version != VERSION {
+    if !(OLDEST_VERSION..=VERSION).contains(&header.version) {
         return Err(what(StatesProblem::Version(header.version)));
     }
     let header_len = bincode::serde::encode_to_vec(&header, config())
         .map_err(|e| what(e.into()))?
         .len() as u64;
-    let record_len = 8 + 8 + 15 * 8 + header.agent_ids.len() as u64 * 27 * 8;
+    let agents = header.agent_ids.len() as u64;
+    let record_len = 8 + 8 + (LEADER_WORDS + agents * agent_words(header.version)) * 8;
     let body = len.saturating_sub(header_len);
     if body % record_len != 0 {
         return Err(what(StatesProblem::Truncated { body, record_len }));
@@ -231,7 +343,7 @@ impl Records {
     /// then decoded; lengths inside that disagree with the header are refused.
     fn record(&mut self) -> Result<Record, StatesProblem> {
         self.r.read_exact(&mut self.buf)?;
-        let (rec, used): (Record, usize) = bincode::serde::decode_from_slice(&self.buf, config())?;
+        let (rec, used) = self.decode()?;
         let agents = self.header.agent_ids.len();
         if used != self.buf.len() || rec.agents.len() != agents {
             return Err(StatesProblem::Agents {
@@ -241,6 +353,16 @@ impl Records {
             });
         }
         Ok(rec)
+    }
+
+    /// The record in `buf`, decoded by its layout version, and the bytes used.
+    fn decode(&self) -> Result<(Record, usize), bincode::error::DecodeError> {
+        let buf = &self.buf;
+        if self.header.version == 1 {
+            let (v1, used): (RecordV1, usize) = bincode::serde::decode_from_slice(buf, config())?;
+            return Ok((v1.into(), used));
+        }
+        bincode::serde::decode_from_slice(buf, config())
     }
 
     /// How many records are left to read.
@@ -304,38 +426,36 @@ impl AgentRecord {
     }
 }
 
+/// The columns of [`export_csv`]: `t,node,r11..r33,w1..w3,r_hat11..r_hat33,
+/// w_hat1..w_hat3,s_hat1..s_hat3,tau1..tau3`.
+#[must_use]
+pub fn csv_columns() -> Vec<String> {
+    let matrix = |name: &str| -> Vec<String> {
+        let cells = (1..=3).flat_map(|i| (1..=3).map(move |j| (i, j)));
+        cells.map(|(i, j)| format!("{name}{i}{j}")).collect()
+    };
+    let vector = |name: &str| -> Vec<String> { (1..=3).map(|i| format!("{name}{i}")).collect() };
+    let mut cols = vec!["t".to_string(), "node".into()];
+    cols.extend(matrix("r"));
+    cols.extend(vector("w"));
+    cols.extend(matrix("r_hat"));
+    cols.extend(vector("w_hat"));
+    cols.extend(vector("s_hat"));
+    cols.extend(vector("tau"));
+    cols
+}
+
 /// Converts `states.bin` to CSV, long form: one row per node per record,
-/// node 0 the leader (`r` = R₀, `w` = ω₀, `s_hat` = σ₀, observer columns empty).
+/// node 0 the leader (`r` = R₀, `w` = ω₀, `s_hat` = σ₀, observer and torque
+/// columns empty); an agent's `tau1..tau3` are its torque at stage 0 of the
+/// record's step (`NaN` at the last step, and in files of layout version 1).
 ///
 /// # Errors
 /// [`CsvError`]: the file cannot be read, or the CSV written.
 pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), CsvError> {
     let (h, records) = read(file)?;
     let io = CsvError::Write;
-    let mut cols = vec!["t".to_string(), "node".into()];
-    for name in ["r", "r_hat"] {
-        for i in 1..=3 {
-            for j in 1..=3 {
-                cols.push(format!("{name}{i}{j}"));
-            }
-        }
-    }
-    for name in ["w", "w_hat", "s_hat"] {
-        for i in 1..=3 {
-            cols.push(format!("{name}{i}"));
-        }
-    }
-    // Order: t,node,r11..r33,w1..w3,r_hat11..r_hat33,w_hat1..3,s_hat1..3
-    let order = [
-        &cols[..2],
-        &cols[2..11],
-        &cols[20..23],
-        &cols[11..20],
-        &cols[23..26],
-        &cols[26..29],
-    ]
-    .concat();
-    writeln!(out, "{}", order.join(",")).map_err(io)?;
+    writeln!(out, "{}", csv_columns().join(",")).map_err(io)?;
     let join = |v: &[f64]| {
         v.iter()
             .map(|x| x.to_string())
@@ -346,23 +466,25 @@ pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), CsvError> {
         let t = super::fmt_time(rec.step, h.dt);
         writeln!(
             out,
-            "{t},0,{},{},{},{},{}",
+            "{t},0,{},{},{},{},{},{}",
             join(&rec.leader.r0),
             join(&rec.leader.w0),
             [""; 9].join(","),
             [""; 3].join(","),
-            join(&rec.leader.s0)
+            join(&rec.leader.s0),
+            [""; 3].join(",")
         )
         .map_err(io)?;
         for (id, a) in h.agent_ids.iter().zip(&rec.agents) {
             writeln!(
                 out,
-                "{t},{id},{},{},{},{},{}",
+                "{t},{id},{},{},{},{},{},{}",
                 join(&a.r),
                 join(&a.w),
                 join(&a.r_hat),
                 join(&a.w_hat),
-                join(&a.s_hat)
+                join(&a.s_hat),
+                join(&a.tau)
             )
             .map_err(io)?;
         }
@@ -395,8 +517,8 @@ pub enum StatesProblem {
     /// It does not begin with [`MAGIC`].
     #[error("not an attsync states file (bad magic)")]
     BadMagic,
-    /// Its layout version is not [`VERSION`].
-    #[error("states layout version {0} (this attsync reads {VERSION})")]
+    /// Its layout version is not one this attsync reads.
+    #[error("states layout version {0} (this attsync reads {OLDEST_VERSION} to {VERSION})")]
     Version(u32),
     /// Its records are not whole.
     #[error("truncated: {body} bytes of records is not a multiple of the record size {record_len}")]

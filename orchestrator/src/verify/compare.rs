@@ -5,8 +5,12 @@
 //!
 //! Fields are named as in Rust, 0-based: the leader's `R0[i][j]`,
 //! `omega0[i]`, `sigma0[i]`; an agent's `R[i][j]`, `omega[i]`,
-//! `R_hat[i][j]`, `omega_hat[i]`, `sigma_hat[i]` (matrices row-major, as
-//! in `states.bin`).
+//! `R_hat[i][j]`, `omega_hat[i]`, `sigma_hat[i]`, `tau[i]` (matrices
+//! row-major, as in `states.bin`).
+//!
+//! A recorded file of an older layout (version 1, without torques) is
+//! compared in the values it holds: if they are all equal, there is no
+//! difference (its bytes cannot equal a re-run's).
 
 use super::VerifyError;
 use crate::results::fmt_time;
@@ -142,9 +146,12 @@ pub fn states(recorded: &Path, rerun: &Path) -> Result<Option<StatesDifference>,
     if let Some(d) = header(&a.header, &b.header) {
         return Ok(Some(d));
     }
-    Ok(Some(
-        records(&mut a, &mut b)?.unwrap_or(StatesDifference::Bytes { offset }),
-    ))
+    let older = a.header.version < b.header.version;
+    Ok(match records(&mut a, &mut b, !older)? {
+        Some(d) => Some(d),
+        None if older => None,
+        None => Some(StatesDifference::Bytes { offset }),
+    })
 }
 
 /// `FILE: error`.
@@ -225,8 +232,13 @@ fn header(a: &Header, b: &Header) -> Option<StatesDifference> {
 }
 
 /// The first record that differs (the headers are equal), read a record at
-/// a time; a recorded record that cannot be read is itself the difference.
-fn records(a: &mut Records, b: &mut Records) -> Result<Option<StatesDifference>, VerifyError> {
+/// a time, torques compared if `torques`; a recorded record that cannot be
+/// read is itself the difference.
+fn records(
+    a: &mut Records,
+    b: &mut Records,
+    torques: bool,
+) -> Result<Option<StatesDifference>, VerifyError> {
     let (ra, rb) = (a.remaining(), b.remaining());
     let h = a.header.clone();
     for (index, (x, y)) in a.by_ref().zip(b.by_ref()).enumerate() {
@@ -256,7 +268,7 @@ fn records(a: &mut Records, b: &mut Records) -> Result<Option<StatesDifference>,
         }
         let agents = h.agent_ids.iter().zip(x.agents.iter().zip(&y.agents));
         for (&id, (p, q)) in agents {
-            if let Some(d) = agent(p, q) {
+            if let Some(d) = agent(p, q, torques) {
                 return Ok(Some(at(node_name(id), d)));
             }
         }
@@ -292,13 +304,14 @@ fn leader(a: &LeaderRecord, b: &LeaderRecord) -> Option<Diff> {
         .or_else(|| first("sigma0", false, &a.s0, &b.s0))
 }
 
-/// An agent's first differing value.
-fn agent(a: &AgentRecord, b: &AgentRecord) -> Option<Diff> {
+/// An agent's first differing value (its torque only if `torques`).
+fn agent(a: &AgentRecord, b: &AgentRecord, torques: bool) -> Option<Diff> {
     first("R", true, &a.r, &b.r)
         .or_else(|| first("omega", false, &a.w, &b.w))
         .or_else(|| first("R_hat", true, &a.r_hat, &b.r_hat))
         .or_else(|| first("omega_hat", false, &a.w_hat, &b.w_hat))
         .or_else(|| first("sigma_hat", false, &a.s_hat, &b.s_hat))
+        .or_else(|| torques.then(|| first("tau", false, &a.tau, &b.tau))?)
 }
 
 /// The first difference of two `errors.csv`.

@@ -206,6 +206,7 @@ fn replay(file: &Path, net: &Network) -> Result<Frames, ViewError> {
             step: rec.step,
             leader: &rec.leader.state(),
             agents: &agents,
+            torques: &rec.torques(),
         });
     }
     Ok(collector.finish())

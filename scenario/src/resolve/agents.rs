@@ -4,7 +4,7 @@ use super::ctx::Ctx;
 use super::ids::Ids;
 use super::kind_name;
 use crate::schema::{ActuatorSpec, AgentSpec, ObserverInit, SchemeKind, TorqueLimit};
-use attitude::actuator::Saturation;
+use attitude::actuator::{RateLimit, Saturation};
 use attitude::body::Inertia;
 use attitude::network::AgentState;
 use nalgebra::{Matrix3, Vector3};
@@ -146,6 +146,9 @@ fn observer(
     rh.map(|rh| (rh, wh, sh))
 }
 
+/// An actuator's limits: on the torque, on its rate of change.
+pub(super) type Limits = (Option<Saturation>, Option<RateLimit>);
+
 /// Every agent's actuator limits, by rank of its id: its own
 /// `agent.actuator`, else `[actuator]`, else none.
 pub(super) fn actuators(
@@ -153,24 +156,45 @@ pub(super) fn actuators(
     all: Option<&ActuatorSpec>,
     agents: &[AgentSpec],
     ids: &Ids,
-) -> Vec<Option<Saturation>> {
-    let every = all.and_then(|a| saturation(c, "actuator.max_torque", a));
+) -> Vec<Limits> {
+    let every = all.map_or((None, None), |a| limits(c, "actuator", a));
     let mut out = vec![every; ids.len()];
     for (k, a) in agents.iter().enumerate() {
-        let own = a.actuator.as_ref();
-        let own =
-            own.and_then(|x| saturation(c, format_args!("agent[{k}].actuator.max_torque"), x));
-        if let (Some(s), Some(r)) = (own, ids.rank(a.id)) {
-            out[r] = Some(s);
+        let Some(own) = a.actuator.as_ref() else {
+            continue;
+        };
+        let own = limits(c, format_args!("agent[{k}].actuator"), own);
+        if let Some(r) = ids.rank(a.id) {
+            out[r] = own;
         }
     }
     out
 }
 
-/// The limits of `a` (at field `f`), or `None` (with an error) unless every
+/// The limits of `a` (at field `f`); each `None` with an error unless
+/// every bound is finite and > 0, and one of them is given.
+fn limits(c: &mut Ctx, f: impl Display + Copy, a: &ActuatorSpec) -> Limits {
+    if a.max_torque.is_none() && a.max_torque_rate.is_none() {
+        c.err(f.to_string(), "needs max_torque, max_torque_rate or both");
+    }
+    let saturation = a
+        .max_torque
+        .and_then(|m| saturation(c, format_args!("{f}.max_torque"), m));
+    let rate = a.max_torque_rate.and_then(|m| {
+        let ok = m.is_finite() && m > 0.0;
+        if !ok {
+            let reason = format!("a torque rate bound must be finite and > 0 N·m/s, got {m}");
+            c.err(format!("{f}.max_torque_rate"), reason);
+        }
+        ok.then_some(RateLimit { max: m })
+    });
+    (saturation, rate)
+}
+
+/// The limits of `m` (at field `f`), or `None` (with an error) unless every
 /// bound is finite and > 0.
-fn saturation(c: &mut Ctx, f: impl Display + Copy, a: &ActuatorSpec) -> Option<Saturation> {
-    let bounds: &[f64] = match &a.max_torque {
+fn saturation(c: &mut Ctx, f: impl Display + Copy, m: TorqueLimit) -> Option<Saturation> {
+    let bounds: &[f64] = match &m {
         TorqueLimit::Norm(m) => std::slice::from_ref(m),
         TorqueLimit::Axes(m) => m,
     };
@@ -181,7 +205,7 @@ fn saturation(c: &mut Ctx, f: impl Display + Copy, a: &ActuatorSpec) -> Option<S
         );
         return None;
     }
-    Some(match a.max_torque {
+    Some(match m {
         TorqueLimit::Norm(max) => Saturation::Norm { max },
         TorqueLimit::Axes(max) => Saturation::Axes { max },
     })

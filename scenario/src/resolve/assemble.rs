@@ -2,13 +2,12 @@
 //! once there are no errors.
 
 use super::agents::Body;
+use super::body::BodyEffects;
 use super::graph::{Adjacency, Edges, LeaderLinks};
 use super::ids::Ids;
 use super::leader::Leader;
 use super::simulation::Timing;
-use attitude::actuator::Saturation;
 use attitude::control::ControlLaw;
-use attitude::effects::Effects;
 use attitude::guard::Envelope;
 use attitude::link::LinkModel;
 use attitude::network::{AgentModel, AgentSpec, Neighbour, Network, Scheme};
@@ -26,8 +25,8 @@ pub(super) struct Parts {
     pub(super) impaired: BTreeMap<(u32, u32), LinkModel>,
     pub(super) guard: Envelope,
     pub(super) law: ControlLaw,
-    /// Actuator limits, by rank of the agents' ids.
-    pub(super) actuators: Vec<Option<Saturation>>,
+    /// The bodies' effects, by rank of the agents' ids.
+    pub(super) effects: Vec<BodyEffects>,
     pub(super) timeline: Timed,
 }
 
@@ -83,15 +82,16 @@ pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
         impaired,
         guard,
         law,
-        actuators,
+        effects,
         timeline,
     } = parts;
     let scheme = scheme.expect("no errors");
     let p = leader.p;
     let agents = bodies
         .into_iter()
+        .zip(effects)
         .enumerate()
-        .map(|(r, body)| {
+        .map(|(r, (body, effects))| {
             let (inertia, a_bar, initial) = body.expect("no errors");
             let id = graph.ids.id(r);
             let neighbours = neighbours(id, r, graph, &impaired);
@@ -99,7 +99,7 @@ pub(super) fn network(parts: Parts, graph: &Graph<'_>) -> Network {
             AgentSpec {
                 model: AgentModel {
                     timeline: timeline.of(id, inputs),
-                    effects: effects(actuators[r]),
+                    effects: effects.of(&inertia),
                     id,
                     inertia,
                     a_bar,
@@ -160,10 +160,4 @@ fn neighbours(
     }));
     neighbours.sort_by_key(|n| n.id);
     neighbours
-}
-
-/// An agent's non-ideal effects, `None` for an ideal body.
-fn effects(saturation: Option<Saturation>) -> Option<Box<Effects>> {
-    let e = Effects { saturation };
-    (!e.is_ideal()).then(|| Box::new(e))
 }

@@ -24,6 +24,7 @@
 
 mod agents;
 mod assemble;
+mod body;
 mod checks;
 mod ctx;
 mod events;
@@ -123,6 +124,17 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
     let ids = agents::ids(&mut c, &s.agents);
     let bodies = agents::bodies(&mut c, &s.agents, kind, &ids);
     let actuators = agents::actuators(&mut c, s.actuator.as_ref(), &s.agents, &ids);
+    let sources = body::Sources {
+        agents: &s.agents,
+        disturbances: &s.disturbances,
+        sensor: s.sensor.as_ref(),
+        controller: s.controller.as_ref(),
+        seed: s.network.seed,
+        dt: time.dt,
+        steps: time.steps.unwrap_or(0),
+        kind,
+    };
+    let effects = body::effects(&mut c, &sources, &ids, actuators);
     let edges = graph::edges(&mut c, &s.edges, &ids);
     let links = graph::leader_links(&mut c, &s.leader_links, &ids);
     let ranked = edges.ranks(&ids);
@@ -160,7 +172,7 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         impaired,
         guard: envelope,
         law,
-        actuators,
+        effects,
         timeline: timeline.timed,
     };
     let incoming = edges.incoming(&ids);
