@@ -153,6 +153,19 @@ fn targets(c: &mut Ctx, f: &str, agents: Option<&[u32]>, ids: &Ids) -> Vec<usize
 /// The shape of `d` (seed 0 for noise: per agent later), or `None` with
 /// errors.
 fn shape(c: &mut Ctx, f: &str, d: &DisturbanceSpec, src: &Sources<'_>) -> Option<Shape> {
+    let before = c.errors.len();
+    foreign_keys(c, f, d);
+    let shape = match d.kind {
+        DisturbanceKind::Constant => constant(c, f, d),
+        DisturbanceKind::Sine => sine(c, f, d),
+        DisturbanceKind::Noise => noise(c, f, d),
+        DisturbanceKind::Impulse => impulse(c, f, d, src),
+    };
+    (c.errors.len() == before).then_some(shape)
+}
+
+/// An error for every key of `d` its kind does not take.
+fn foreign_keys(c: &mut Ctx, f: &str, d: &DisturbanceSpec) {
     let given: [(&str, bool); 8] = [
         ("torque", d.torque.is_some()),
         ("amplitude", d.amplitude.is_some()),
@@ -169,7 +182,6 @@ fn shape(c: &mut Ctx, f: &str, d: &DisturbanceSpec, src: &Sources<'_>) -> Option
         DisturbanceKind::Noise => &["std", "bandwidth"],
         DisturbanceKind::Impulse => &["t", "impulse"],
     };
-    let before = c.errors.len();
     for (key, set) in given {
         if set && !own.contains(&key) {
             let kind = d.kind.name();
@@ -182,70 +194,73 @@ fn shape(c: &mut Ctx, f: &str, d: &DisturbanceSpec, src: &Sources<'_>) -> Option
             );
         }
     }
-    let need = |c: &mut Ctx, key: &str, v: Option<()>| {
-        if v.is_none() {
-            let kind = d.kind.name();
-            c.err(
-                format!("{f}.{key}"),
-                format!("is required by kind = \"{kind}\""),
-            );
-        }
-    };
-    let shape = match d.kind {
-        DisturbanceKind::Constant => {
-            need(c, "torque", d.torque.map(|_| ()));
-            let torque = d.torque.unwrap_or_default();
-            c.vec3(format_args!("{f}.torque"), &torque);
-            Shape::Constant { torque }
-        }
-        DisturbanceKind::Sine => {
-            need(c, "amplitude", d.amplitude.map(|_| ()));
-            need(c, "frequency", d.frequency.map(|_| ()));
-            let amplitude = d.amplitude.unwrap_or_default();
-            c.vec3(format_args!("{f}.amplitude"), &amplitude);
-            let frequency = d
-                .frequency
-                .map_or(1.0, |x| c.positive(format_args!("{f}.frequency"), x));
-            let phase = d.phase.unwrap_or(0.0);
-            c.finite(format_args!("{f}.phase"), phase);
-            Shape::Sine {
-                amplitude,
-                frequency,
-                phase,
-            }
-        }
-        DisturbanceKind::Noise => {
-            need(c, "std", d.std.map(|_| ()));
-            need(c, "bandwidth", d.bandwidth.map(|_| ()));
-            let std = d.std.map_or([0.0; 3], |s| s.axes());
-            if std.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
-                c.err(
-                    format!("{f}.std"),
-                    format!("must be finite and ≥ 0 N·m, got {std:?}"),
-                );
-            }
-            let bandwidth = d
-                .bandwidth
-                .map_or(1.0, |x| c.positive(format_args!("{f}.bandwidth"), x));
-            Shape::Noise {
-                std,
-                bandwidth,
-                seed: 0,
-            }
-        }
-        DisturbanceKind::Impulse => {
-            need(c, "t", d.t.map(|_| ()));
-            need(c, "impulse", d.impulse.map(|_| ()));
-            let impulse = d.impulse.unwrap_or_default();
-            c.vec3(format_args!("{f}.impulse"), &impulse);
-            let step = d.t.and_then(|t| step_of(c, format_args!("{f}.t"), t, src));
-            Shape::Impulse {
-                step: step.unwrap_or(0),
-                impulse,
-            }
-        }
-    };
-    (c.errors.len() == before).then_some(shape)
+}
+
+/// An error unless `key` of `d` is `given`.
+fn need(c: &mut Ctx, f: &str, d: &DisturbanceSpec, key: &str, given: bool) {
+    if !given {
+        let kind = d.kind.name();
+        c.err(
+            format!("{f}.{key}"),
+            format!("is required by kind = \"{kind}\""),
+        );
+    }
+}
+
+fn constant(c: &mut Ctx, f: &str, d: &DisturbanceSpec) -> Shape {
+    need(c, f, d, "torque", d.torque.is_some());
+    let torque = d.torque.unwrap_or_default();
+    c.vec3(format_args!("{f}.torque"), &torque);
+    Shape::Constant { torque }
+}
+
+fn sine(c: &mut Ctx, f: &str, d: &DisturbanceSpec) -> Shape {
+    need(c, f, d, "amplitude", d.amplitude.is_some());
+    need(c, f, d, "frequency", d.frequency.is_some());
+    let amplitude = d.amplitude.unwrap_or_default();
+    c.vec3(format_args!("{f}.amplitude"), &amplitude);
+    let frequency = d
+        .frequency
+        .map_or(1.0, |x| c.positive(format_args!("{f}.frequency"), x));
+    let phase = d.phase.unwrap_or(0.0);
+    c.finite(format_args!("{f}.phase"), phase);
+    Shape::Sine {
+        amplitude,
+        frequency,
+        phase,
+    }
+}
+
+fn noise(c: &mut Ctx, f: &str, d: &DisturbanceSpec) -> Shape {
+    need(c, f, d, "std", d.std.is_some());
+    need(c, f, d, "bandwidth", d.bandwidth.is_some());
+    let std = d.std.map_or([0.0; 3], |s| s.axes());
+    if std.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+        c.err(
+            format!("{f}.std"),
+            format!("must be finite and ≥ 0 N·m, got {std:?}"),
+        );
+    }
+    let bandwidth = d
+        .bandwidth
+        .map_or(1.0, |x| c.positive(format_args!("{f}.bandwidth"), x));
+    Shape::Noise {
+        std,
+        bandwidth,
+        seed: 0,
+    }
+}
+
+fn impulse(c: &mut Ctx, f: &str, d: &DisturbanceSpec, src: &Sources<'_>) -> Shape {
+    need(c, f, d, "t", d.t.is_some());
+    need(c, f, d, "impulse", d.impulse.is_some());
+    let impulse = d.impulse.unwrap_or_default();
+    c.vec3(format_args!("{f}.impulse"), &impulse);
+    let step = d.t.and_then(|t| step_of(c, format_args!("{f}.t"), t, src));
+    Shape::Impulse {
+        step: step.unwrap_or(0),
+        impulse,
+    }
 }
 
 /// `t` as a step of the run: a whole multiple of `dt` in `[0, duration)`.
