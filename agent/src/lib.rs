@@ -44,7 +44,10 @@ impl AgentNode {
     pub fn from_config(cfg: &NodeConfig) -> Result<Self, RoleError> {
         match &cfg.role {
             Role::Agent { model, initial } => Ok(Self {
-                agent: Agent::new((**model).clone(), *initial, cfg.dt),
+                agent: match &cfg.resume {
+                    Some(from) => Agent::resumed((**model).clone(), *initial, cfg.dt, from),
+                    None => Agent::new((**model).clone(), *initial, cfg.dt),
+                },
             }),
             Role::Leader { .. } => Err(RoleError::Leader(cfg.id)),
         }
@@ -84,6 +87,8 @@ impl Stepper for AgentNode {
     }
 
     fn torque(&self, step: u64) -> Option<Telemetry> {
+        // A down agent applies none: the run records NaN.
+        (!self.agent.is_down()).then_some(())?;
         Some(Telemetry::Torque {
             step,
             tau: self.agent.torque(),
@@ -92,6 +97,19 @@ impl Stepper for AgentNode {
 
     fn link_stats(&self) -> Vec<(u32, attitude::link::LinkStats)> {
         self.agent.link_stats()
+    }
+
+    fn crash(&self, step: u64) -> Option<Telemetry> {
+        let timeline = self.agent.model().timeline.as_deref()?;
+        timeline.crash_at(step).map(|_| Telemetry::Crashed {
+            step,
+            state: *self.agent.state(),
+            peak_torque: self.agent.peak_torque(),
+        })
+    }
+
+    fn is_down(&self) -> bool {
+        self.agent.is_down()
     }
 }
 

@@ -25,6 +25,7 @@ use crate::observer::{
 use crate::timeline::{Absent, Due};
 use crate::verdict::Verdicts;
 use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
 
 /// The closed-loop vector field of agent i and the torque it applies
 /// (the law's, saturated as `model.effects` says: [`crate::actuator`]).
@@ -247,7 +248,7 @@ pub struct Agent {
 
 /// The state of an agent's timeline ([`crate::timeline`]) and of its
 /// body's random effects ([`crate::effects`]).
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 struct Timed {
     /// The retunes taken so far.
     retuned: Due,
@@ -256,6 +257,36 @@ struct Timed {
     absent: Option<Absent>,
     /// What the body's noise and sensors hold this step.
     effects: Option<EffectsState>,
+    /// While the agent is down (crashed, [`crate::timeline::Crash`]).
+    down: Option<Down>,
+    /// The state at t = 0, for a restart from it.
+    initial: AgentState,
+}
+
+/// An agent that is down: the stage it is at, and how it comes back.
+#[derive(Debug, Clone, Copy)]
+struct Down {
+    stage: usize,
+    until: Option<u64>,
+    initial: bool,
+}
+
+/// Stages of a step (RKMK4).
+const STAGES: usize = 4;
+
+/// What a new process of a crashed agent takes over from the one that
+/// crashed ([`Agent::resumed`]): where it is, and the counters that carry on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Carried {
+    /// The step it crashed at.
+    pub step: u64,
+    /// Its state at the start of that step.
+    pub state: AgentState,
+    /// Its peak torque so far, N·m.
+    pub peak_torque: f64,
+    /// The counters of its inputs so far: (sender id, stats), as
+    /// [`Agent::link_stats`] gives them.
+    pub links: Vec<(u32, LinkStats)>,
 }
 
 impl Agent {
@@ -266,24 +297,7 @@ impl Agent {
         let held_nbrs = vec![Exchanged::identity(); model.neighbours.len()];
         let held_leader = model.leader_gain.map(|_| Box::new(Exchanged::identity()));
         let timeline = model.timeline.as_deref();
-        let impaired = |l: &Option<LinkModel>, from: u32| {
-            let outages = timeline.map_or(&[][..], |t| t.outages_of(from));
-            match l.filter(LinkModel::is_impaired) {
-                None if outages.is_empty() => None,
-                m => Some(Box::new(Link::with_outages(
-                    m.unwrap_or_else(LinkModel::ideal),
-                    outages.to_vec(),
-                ))),
-            }
-        };
-        let mut links: Vec<Option<Box<Link>>> = model
-            .neighbours
-            .iter()
-            .map(|n| impaired(&n.link, n.id))
-            .collect();
-        if model.leader_gain.is_some() {
-            links.push(impaired(&model.leader_link, 0));
-        }
+        let links = links_of(&model);
         let rejected = vec![0; links.len()].into_boxed_slice();
         let impaired = links.iter().any(Option::is_some);
         let forgets = links.iter().flatten().any(|l| l.ever_forgets());
@@ -296,6 +310,8 @@ impl Agent {
                     ..Absent::default()
                 }),
                 effects,
+                down: None,
+                initial,
             })
         });
         let mut agent = Self {
@@ -315,10 +331,116 @@ impl Agent {
             tau0: Vector3::zeros(),
             verdicts: Verdicts::default(),
         };
-        agent.retune();
-        agent.left_out();
-        agent.draw();
+        agent.step_started();
         agent
+    }
+
+    /// A new process's agent taking over from one that crashed at step
+    /// `from.step` ([`Carried`]): down from there as the crashed one would
+    /// be, restarting as its timeline says, bit-identical to an agent that
+    /// ran through the crash in one process.
+    #[must_use]
+    pub fn resumed(model: AgentModel, initial: AgentState, dt: f64, from: &Carried) -> Self {
+        let mut a = Self::new(model, initial, dt);
+        a.n = from.step;
+        a.state = from.state;
+        a.stage_x = from.state;
+        a.step = Stages::new(&[from.state.w, from.state.w_hat, from.state.s_hat], dt);
+        a.peak_torque = from.peak_torque;
+        let ids: Vec<u32> = (a.model.neighbours.iter().map(|n| n.id))
+            .chain(a.model.leader_gain.map(|_| 0))
+            .collect();
+        for &(id, s) in &from.links {
+            let Some(k) = ids.iter().position(|&i| i == id) else {
+                continue;
+            };
+            a.rejected[k] = s.rejected;
+            if let Some(l) = a.links[k].take() {
+                a.links[k] = Some(Box::new(l.counting_from(LinkStats { rejected: 0, ..s })));
+            }
+        }
+        a.step_started();
+        a
+    }
+
+    /// What happens at the start of a step: a crash or a restart, a
+    /// retune, the inputs left out, the body's random draws.
+    fn step_started(&mut self) {
+        if self.timed.is_none() {
+            return;
+        }
+        self.crash_or_restart();
+        self.retune();
+        self.left_out();
+        self.draw();
+    }
+
+    /// Goes down at a crash due now, or comes back at its restart.
+    fn crash_or_restart(&mut self) {
+        let (Some(timeline), Some(t)) = (self.model.timeline.as_deref(), self.timed.as_deref_mut())
+        else {
+            return;
+        };
+        match t.down {
+            Some(d) if d.until == Some(self.n) => self.restart(d.initial),
+            Some(_) => {}
+            None => {
+                if let Some(c) = timeline.crash_at(self.n) {
+                    t.down = Some(Down {
+                        stage: 0,
+                        until: c.to,
+                        initial: c.initial,
+                    });
+                }
+            }
+        }
+    }
+
+    /// Starts afresh at the current step ([`crate::timeline`]'s crash):
+    /// from the initial state or the one it had, links as at t = 0 but
+    /// counting on, held values the identity, the body's effects reset.
+    fn restart(&mut self, initial: bool) {
+        let Some(t) = self.timed.as_deref_mut() else {
+            return;
+        };
+        t.down = None;
+        let x = if initial { t.initial } else { self.state };
+        let h = self.step.h();
+        t.effects = (self.model.effects.as_deref()).and_then(|e| EffectsState::new(e, h));
+        self.state = x;
+        self.stage_x = x;
+        self.step = Stages::new(&[x.w, x.w_hat, x.s_hat], h);
+        self.held_nbrs.fill(Exchanged::identity());
+        if let Some(l) = &mut self.held_leader {
+            **l = Exchanged::identity();
+        }
+        let fresh = links_of(&self.model);
+        for (old, new) in self.links.iter_mut().zip(fresh) {
+            let stats = old.as_deref().map(Link::stats).unwrap_or_default();
+            *old = new.map(|l| Box::new(l.counting_from(stats)));
+        }
+        self.tau0 = Vector3::zeros();
+        self.verdicts = Verdicts::default();
+    }
+
+    /// Whether the agent is down (crashed) at the current step.
+    #[must_use]
+    pub fn is_down(&self) -> bool {
+        self.timed.as_deref().is_some_and(|t| t.down.is_some())
+    }
+
+    /// One stage of a down agent: nothing is evaluated; `Some(true)` when a
+    /// step completed, `None` if the agent is up.
+    fn pass_down(&mut self) -> Option<bool> {
+        let d = self.timed.as_deref_mut()?.down.as_mut()?;
+        d.stage += 1;
+        if d.stage < STAGES {
+            return Some(false);
+        }
+        d.stage = 0;
+        self.n += 1;
+        self.step_started();
+        Some(true)
     }
 
     /// Draws what the body's random effects hold over the current step,
@@ -380,12 +502,19 @@ impl Agent {
     /// step's first [`Self::advance`]); zero before the first step.
     #[must_use]
     pub fn torque(&self) -> Vector3<f64> {
+        if self.is_down() {
+            return Vector3::repeat(f64::NAN);
+        }
         self.tau0
     }
 
     /// What the agent publishes at the current stage.
     #[must_use]
     pub fn stage_exchange(&self) -> Exchanged {
+        if self.is_down() {
+            // Nobody receives it: the receivers' timelines drop it.
+            return exchanged_of(&self.model.scheme, &self.state);
+        }
         match self.sensed_stage() {
             Some(m) => exchanged_of(&self.model.scheme, &m),
             None => exchanged_of(&self.model.scheme, &self.stage_x),
@@ -435,11 +564,12 @@ impl Agent {
     #[inline]
     pub(crate) fn publish_into(&mut self, out: &mut Exchanged) -> bool {
         *out = self.stage_exchange();
-        if self
-            .model
-            .effects
-            .as_ref()
-            .is_some_and(|e| e.sensor.is_some())
+        if self.is_down()
+            || self
+                .model
+                .effects
+                .as_ref()
+                .is_some_and(|e| e.sensor.is_some())
         {
             // a measured attitude is not the integrator's stage point: no proof
             return out.trust().is_ok();
@@ -471,6 +601,9 @@ impl Agent {
     /// (it is handed to [`Self::advance_with`] from where it lies).
     #[inline]
     pub(crate) fn hear_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool) {
+        if self.timed.is_some() && self.is_down() {
+            return;
+        }
         if !trusted {
             self.rejected[k] += 1;
             return;
@@ -486,6 +619,9 @@ impl Agent {
     /// [`Self::receive_neighbour_judged`] from where the value lies (one
     /// copy, into the held value).
     fn hold_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool) {
+        if self.is_down() {
+            return;
+        }
         if !trusted {
             self.rejected[k] += 1;
             return;
@@ -507,6 +643,9 @@ impl Agent {
     /// evaluated (see [`Self::receive_neighbour_judged`]).
     pub fn receive_leader_judged(&mut self, x: Exchanged, trusted: bool) {
         let k = self.model.neighbours.len();
+        if self.is_down() {
+            return;
+        }
         if self.held_leader.is_some() && !trusted {
             self.rejected[k] += 1;
             return;
@@ -541,6 +680,9 @@ impl Agent {
     /// Evaluates the current stage with the held inputs and moves on.
     /// Returns `true` when a step completed.
     pub fn advance(&mut self) -> bool {
+        if let Some(done) = self.pass_down() {
+            return done;
+        }
         self.update_links();
         let leader = self.held_leader.as_deref();
         let (absent, state) = split(self.timed.as_deref_mut());
@@ -558,6 +700,9 @@ impl Agent {
     /// entry is replaced by its link's held value. The same arithmetic on
     /// the same values as [`Self::advance`], bit for bit.
     pub(crate) fn advance_with(&mut self, nbrs: &mut [Exchanged]) -> bool {
+        if let Some(done) = self.pass_down() {
+            return done;
+        }
         if self.impaired {
             self.update_links();
             for ((x, link), held) in nbrs.iter_mut().zip(&self.links).zip(&self.held_nbrs) {
@@ -605,11 +750,7 @@ impl Agent {
                 self.step.restart(&next.vec);
                 self.stage_x = self.state;
                 self.n += 1;
-                if self.timed.is_some() {
-                    self.retune();
-                    self.left_out();
-                    self.draw();
-                }
+                self.step_started();
                 true
             }
             None => {
@@ -618,4 +759,27 @@ impl Agent {
             }
         }
     }
+}
+
+/// The receiving ends of `model`'s impaired inputs (neighbours, then the
+/// leader): a link with impairments or outages, `None` for a plain one.
+fn links_of(model: &AgentModel) -> Vec<Option<Box<Link>>> {
+    let timeline = model.timeline.as_deref();
+    let impaired = |l: &Option<LinkModel>, from: u32| {
+        let outages = timeline.map_or(&[][..], |t| t.outages_of(from));
+        match l.filter(LinkModel::is_impaired) {
+            None if outages.is_empty() => None,
+            m => Some(Box::new(Link::with_outages(
+                m.unwrap_or_else(LinkModel::ideal),
+                outages.to_vec(),
+            ))),
+        }
+    };
+    let mut links: Vec<Option<Box<Link>>> = (model.neighbours.iter())
+        .map(|n| impaired(&n.link, n.id))
+        .collect();
+    if model.leader_gain.is_some() {
+        links.push(impaired(&model.leader_link, 0));
+    }
+    links
 }

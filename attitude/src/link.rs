@@ -273,4 +273,12 @@ impl Link {
     pub fn stats(&self) -> LinkStats {
         self.stats
     }
+
+    /// The link with its counters starting from `stats` (a link of an agent
+    /// that restarted: its counters carry on).
+    #[must_use]
+    pub fn counting_from(mut self, stats: LinkStats) -> Self {
+        self.stats = stats;
+        self
+    }
 }

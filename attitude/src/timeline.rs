@@ -14,6 +14,16 @@
 //!   scheme gains (`set = { "scheme.control.k_r" = … }`).
 //! - A **repoint**: at the start of step `step` the constant reference
 //!   `R₀` jumps to another attitude (`set = { "leader.attitude" = … }`).
+//! - A **crash** of an agent at the start of step `from`: until step `to`
+//!   (its restart) it is not simulated at all. Its state stays what it was
+//!   at the crash, it applies no torque, it hears nothing, and its
+//!   receivers get nothing from it (an outage that holds, resolved into
+//!   their timelines). At `to` it starts afresh: from the state it had at
+//!   the crash (`last`) or its initial state (`initial`), with its links
+//!   as at t = 0 (nothing in flight, random streams from their seeds), its
+//!   held values the identity until its inputs' next exchange, the body's
+//!   random effects and the rate limit's anchor reset; the counters of its
+//!   links and its peak torque carry on.
 //!
 //! Nothing here knows about seconds: the scenario resolves `t` into steps
 //! (`t = step · dt`). `PROTOCOL.md` § 10.10 states it for plug-ins.
@@ -72,6 +82,21 @@ pub struct Repoint {
     pub r0: Matrix3<f64>,
 }
 
+/// The agent's process ends at the start of step `from`; a new one takes
+/// over at the start of step `to` (`None`: it stays down to the end).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Crash {
+    /// The first step it is down.
+    pub from: u64,
+    /// The step it restarts at, if it does.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub to: Option<u64>,
+    /// Whether it restarts from its initial state (else from the state it
+    /// had at the crash).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub initial: bool,
+}
+
 /// What one agent's timeline holds (empty: nothing happens to it).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct AgentTimeline {
@@ -81,13 +106,22 @@ pub struct AgentTimeline {
     /// Changes of its gains, by ascending step.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub retune: Vec<Retune>,
+    /// Its crashes, by ascending step, disjoint.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub crashes: Vec<Crash>,
 }
 
 impl AgentTimeline {
     /// Whether nothing happens (then it is not written).
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.down.is_empty() && self.retune.is_empty()
+        self.down.is_empty() && self.retune.is_empty() && self.crashes.is_empty()
+    }
+
+    /// The crash that starts at step `n`, if one does.
+    #[must_use]
+    pub fn crash_at(&self, n: u64) -> Option<&Crash> {
+        self.crashes.iter().find(|c| c.from == n)
     }
 
     /// The outages of the input from `sender` (0: the leader).

@@ -77,6 +77,8 @@ pub struct Supervisor {
     pids: Vec<u32>,
     /// The node index of each of `pids`.
     indices: Vec<usize>,
+    /// Exits read while waiting for another one ([`Self::kill_node`]).
+    early: std::collections::VecDeque<Exit>,
 }
 
 impl Supervisor {
@@ -98,6 +100,7 @@ impl Supervisor {
             keep_groups: false,
             pids: Vec::new(),
             indices: Vec::new(),
+            early: std::collections::VecDeque::new(),
         })
     }
 
@@ -233,6 +236,9 @@ impl Supervisor {
 
     /// An exit that happened since the last call, if any.
     pub fn try_exit(&mut self) -> Option<Exit> {
+        if let Some(e) = self.early.pop_front() {
+            return Some(e);
+        }
         let e = self.exits.try_recv().ok()?;
         self.ended += 1;
         Some(e)
@@ -240,6 +246,9 @@ impl Supervisor {
 
     /// The next exit, waiting up to `timeout` for one.
     pub fn next_exit(&mut self, timeout: Duration) -> Option<Exit> {
+        if let Some(e) = self.early.pop_front() {
+            return Some(e);
+        }
         let e = self.exits.recv_timeout(timeout).ok()?;
         self.ended += 1;
         Some(e)
@@ -251,6 +260,26 @@ impl Supervisor {
         self.ended == self.started
     }
 
+    /// Kills node `index`'s latest process (SIGKILL to its group) and waits
+    /// up to `timeout` for it to end: its pid, once it has (`None`: no such
+    /// process, or it outlived `timeout`). Other exits meanwhile are kept
+    /// for [`Self::try_exit`] and [`Self::next_exit`].
+    pub fn kill_node(&mut self, index: usize, timeout: Duration) -> Option<u32> {
+        let k = self.indices.iter().rposition(|&i| i == index)?;
+        let pid = self.pids[k];
+        kill_group(Some(pid));
+        let deadline = Instant::now() + timeout;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            let e = self.exits.recv_timeout(left).ok()?;
+            self.ended += 1;
+            if e.index == index && e.pgid == Some(pid) {
+                return Some(pid);
+            }
+            self.early.push_back(e);
+        }
+    }
+
     /// Kills every process still running (SIGKILL).
     pub fn kill_all(&self) {
         let _ = self.kill.send(true);
@@ -259,7 +288,7 @@ impl Supervisor {
     /// Waits up to `timeout` for every process to end, returning the exits;
     /// kills the rest after that and waits for them too.
     pub fn wait_all(&mut self, timeout: Duration) -> Vec<Exit> {
-        let mut out = Vec::new();
+        let mut out: Vec<Exit> = self.early.drain(..).collect();
         let deadline = Instant::now() + timeout;
         while !self.all_ended() {
             let left = deadline.saturating_duration_since(Instant::now());

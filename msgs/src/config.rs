@@ -121,6 +121,12 @@ pub struct NodeConfig {
     pub contention: Contention,
     /// The node's role and model.
     pub role: Role,
+    /// For a new process of an agent that crashed: where the crashed one
+    /// stopped and what carries on ([`attitude::agent::Carried`]); it
+    /// begins at that step, down, without waiting for `Start`
+    /// (PROTOCOL.md § 10.10). Absent for every other node.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resume: Option<attitude::agent::Carried>,
 }
 
 impl NodeConfig {
@@ -265,6 +271,7 @@ mod tests {
                     s_hat: Vector3::new(3.0, 2.5, 2.0),
                 },
             },
+            resume: None,
         }
     }
 

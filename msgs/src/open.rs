@@ -53,9 +53,15 @@ impl Limits {
             .chain(readers.into_values())
             .max()
             .unwrap_or(0);
+        // A crashed agent's ports stay until its new process has opened
+        // its own (PROTOCOL.md § 10.10): one more of each, then.
+        let restarts = net
+            .agents
+            .iter()
+            .any(|a| (a.model.timeline.as_deref()).is_some_and(|t| !t.crashes.is_empty()));
         Self {
             nodes: net.agents.len() + 1,
-            max_fanout: leader_links.max(max_degree).max(1),
+            max_fanout: leader_links.max(max_degree).max(1) + usize::from(restarts),
             state_buffer: 64,
             telemetry_buffer: 256,
         }

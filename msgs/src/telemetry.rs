@@ -62,6 +62,17 @@ pub enum Telemetry {
     Done(Done),
     /// The node gives up while stepping, just before it exits.
     Failed(FailReason),
+    /// A built-in agent has reached the step its timeline crashes it at
+    /// (PROTOCOL.md § 10.10): its state then, after its links' counters
+    /// (`LinkStats`); it publishes nothing more and waits to be killed.
+    Crashed {
+        /// The step it crashes at.
+        step: u64,
+        /// Its state at the start of that step.
+        state: AgentState,
+        /// Largest ‖τᵢ‖ applied so far, N·m.
+        peak_torque: f64,
+    },
 }
 
 impl Telemetry {
@@ -148,11 +159,13 @@ pub enum TelemetryKind {
     LeaderSample = 6,
     /// [`Telemetry::Torque`].
     Torque = 7,
+    /// [`Telemetry::Crashed`].
+    Crashed = 8,
 }
 
 impl TelemetryKind {
     /// Every kind.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 8] = [
         Self::Ready,
         Self::Sample,
         Self::Done,
@@ -160,6 +173,7 @@ impl TelemetryKind {
         Self::Failed,
         Self::LeaderSample,
         Self::Torque,
+        Self::Crashed,
     ];
 
     /// The kind whose wire code is `code` (`None`: no kind has it).
@@ -177,6 +191,7 @@ impl TelemetryKind {
             Telemetry::LinkStats { .. } => Self::LinkStats,
             Telemetry::Done(_) => Self::Done,
             Telemetry::Failed(_) => Self::Failed,
+            Telemetry::Crashed { .. } => Self::Crashed,
         }
     }
 }
@@ -266,6 +281,11 @@ impl TelemetryMsg {
                 step,
                 state,
                 peak_torque,
+            }
+            | Telemetry::Crashed {
+                step,
+                state,
+                peak_torque,
             } => {
                 b.u64(16, *step);
                 b.f64s(24, &to_rows(&state.r));
@@ -313,13 +333,12 @@ impl TelemetryMsg {
             TelemetryKind::Ready => Telemetry::Ready,
             TelemetryKind::Sample => Telemetry::Sample {
                 step: b.u64(16),
-                state: AgentState {
-                    r: from_rows(&b.f64s(24)),
-                    w: Vector3::from(b.f64s(96)),
-                    r_hat: from_rows(&b.f64s(120)),
-                    w_hat: Vector3::from(b.f64s(192)),
-                    s_hat: Vector3::from(b.f64s(216)),
-                },
+                state: agent_state(&b),
+                peak_torque: b.f64(240),
+            },
+            TelemetryKind::Crashed => Telemetry::Crashed {
+                step: b.u64(16),
+                state: agent_state(&b),
                 peak_torque: b.f64(240),
             },
             TelemetryKind::LeaderSample => Telemetry::LeaderSample {
@@ -338,6 +357,17 @@ impl TelemetryMsg {
             TelemetryKind::Done => Telemetry::Done(decode_done(&b)),
             TelemetryKind::Failed => Telemetry::Failed(decode_failed(&b)?),
         })
+    }
+}
+
+/// The agent state of a `Sample` or `Crashed` body.
+fn agent_state(b: &Reader) -> AgentState {
+    AgentState {
+        r: from_rows(&b.f64s(24)),
+        w: Vector3::from(b.f64s(96)),
+        r_hat: from_rows(&b.f64s(120)),
+        w_hat: Vector3::from(b.f64s(192)),
+        s_hat: Vector3::from(b.f64s(216)),
     }
 }
 

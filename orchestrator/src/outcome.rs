@@ -28,6 +28,26 @@ pub struct Outcome {
     /// What each node that finished reported with `Done`: (name, id,
     /// report). Empty in-process.
     pub nodes: Vec<(String, u32, Done)>,
+    /// The agents' processes that crashed and the ones that took over, in
+    /// order. Empty in-process.
+    pub restarts: Vec<Restart>,
+}
+
+/// A crashed agent's process replaced by a new one (`summary.json`'s
+/// `restarts`; PROTOCOL.md § 10.10).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Restart {
+    /// The agent.
+    pub agent: u32,
+    /// The step it crashed at.
+    pub step: u64,
+    /// The process that crashed.
+    pub pid_before: u32,
+    /// The process that took over.
+    pub pid_after: u32,
+    /// Wall time from the crash's report to the new process's `Ready`, ms
+    /// (`None` if it never became ready).
+    pub handover_ms: Option<f64>,
 }
 
 impl Outcome {
@@ -68,6 +88,7 @@ impl Outcome {
             links,
             pacing: Vec::new(),
             nodes: Vec::new(),
+            restarts: Vec::new(),
         }
     }
 }

@@ -548,6 +548,7 @@ fn summarise(
         nodes: (outcome.nodes.iter())
             .map(|(name, id, d)| NodeSummary::of(*id, name, d))
             .collect(),
+        restarts: outcome.restarts.clone(),
         threads: None,
         verdict: Some(judged.verdict),
         until: judged.until,
@@ -689,6 +690,15 @@ impl RunEnd {
 /// Options that the scenario cannot run with.
 fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), OptionError> {
     let plugins = &loaded.resolved.plugins;
+    let crashes = (loaded.resolved.network.agents.iter())
+        .any(|a| (a.model.timeline.as_deref()).is_some_and(|t| !t.crashes.is_empty()));
+    if crashes && (opts.processes.realtime.is_some() || opts.hosts.is_some()) {
+        return Err(OptionError::Conflict(
+            "a crash ([[event]] action = \"crash\") cannot run with --realtime or --hosts: \
+             the orchestrator replaces a crashed process at a lockstep step on this machine"
+                .into(),
+        ));
+    }
     if opts.engine == Engine::InProcess {
         if let Some(p) = plugins.first() {
             return Err(OptionError::Conflict(format!(

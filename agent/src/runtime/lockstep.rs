@@ -6,6 +6,7 @@
 use super::hooks::{Hooked, Hooks};
 use super::{
     Inputs, NodeError, Orphan, Stepper, after_stage_0, after_step, before_step, check_origin,
+    crash_point,
 };
 use crate::wait::Waiter;
 use attitude::schedule::{Schedule, Slot};
@@ -25,13 +26,24 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
     orphan: &Orphan,
 ) -> Result<Pacing, NodeError> {
     let mut waiter = Waiter::new(cfg.wait).with_contention(cfg.contention);
-    io.report(stepper.sample(0))?;
-    for slot in Schedule::new(cfg.coupling, cfg.steps).slots() {
+    let first = cfg.resume.as_ref().map_or(0, |r| r.step);
+    if first == 0 {
+        io.report(stepper.sample(0))?;
+    }
+    let mut held = Held::new(cfg);
+    let slots = Schedule::new(cfg.coupling, cfg.steps).slots();
+    for slot in slots.skip_while(|s| s.step < first) {
         if slot.starts_step() {
             before_step(slot.step, shutdown, orphan)?;
+            if slot.step > first {
+                crash_point(io, (cfg, inputs), stepper, slot.step, (shutdown, orphan))?;
+            }
         }
-        if slot.exchange {
-            exchange(io, cfg, stepper, inputs, &mut waiter, slot, orphan)?;
+        if slot.exchange && stepper.is_down() {
+            stand_in(io, cfg, stepper, (&mut held, &mut waiter), slot, orphan)?;
+        } else if slot.exchange {
+            let take = (&mut *inputs, &mut held);
+            exchange(io, cfg, stepper, take, &mut waiter, slot, orphan)?;
         }
         stepper.advance();
         if slot.starts_step() {
@@ -44,12 +56,98 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
     Ok(Pacing::default())
 }
 
+/// What a new process of a crashed agent took from an input before it
+/// was due (PROTOCOL.md § 10.10): while down it reads its inputs without
+/// waiting, and keeps the first message stamped after the current
+/// exchange for when it is up again. Empty for every other node.
+struct Held {
+    /// Per input.
+    next: Vec<Option<StateMsg>>,
+    /// Whether this process took over from a crashed one (then messages
+    /// older than the exchange due are leftovers of the time it was down).
+    resumed: bool,
+}
+
+impl Held {
+    fn new(cfg: &NodeConfig) -> Self {
+        Self {
+            next: vec![None; cfg.inputs.len()],
+            resumed: cfg.resume.is_some(),
+        }
+    }
+
+    /// Input `k`'s next message, the one kept first.
+    fn take<S: Service, H: Hooks>(
+        &mut self,
+        io: &mut Hooked<'_, S, H>,
+        k: usize,
+    ) -> Result<Option<StateMsg>, NodeError> {
+        match self.next[k].take() {
+            Some(m) => Ok(Some(m)),
+            None => io.receive(k),
+        }
+    }
+}
+
+/// Exchange `slot` of a node that is down: publishes its stand-in (its
+/// receivers' timelines drop it), then reads what its inputs have sent up
+/// to `slot`, keeping the first later message. It waits only for inputs
+/// that also receive from it, until one message stamped `slot` or later
+/// came: that receiver has its stand-in, so this process, new to its
+/// receivers, never sends more than their buffers hold before they
+/// attach to it (iceoryx2 drops what a full buffer of a receiver not yet
+/// attached cannot take). Messages lost before it attached are of no
+/// matter: nothing a down node receives is used.
+fn stand_in<S: Service, N: Stepper, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
+    cfg: &NodeConfig,
+    stepper: &N,
+    (held, waiter): (&mut Held, &mut Waiter),
+    slot: Slot,
+    orphan: &Orphan,
+) -> Result<(), NodeError> {
+    let now = (slot.step, slot.stage);
+    let msg = StateMsg::new(cfg.id, now.0, now.1, &stepper.stage_exchange());
+    io.publish(slot, msg, true)?;
+    let deadline = Instant::now() + Duration::from_secs_f64(cfg.stage_timeout);
+    waiter.begin();
+    for k in 0..cfg.inputs.len() {
+        let paces = cfg.outputs.contains(&cfg.inputs[k]);
+        loop {
+            match held.take(io, k)? {
+                Some(m) if (m.step, m.stage) < now => continue,
+                Some(m) => {
+                    if (m.step, m.stage) > now {
+                        held.next[k] = Some(m);
+                    }
+                    break;
+                }
+                None if !paces => break,
+                None => {
+                    if waiter.polls() % 64 == 63 {
+                        orphan.poll()?;
+                    }
+                    if waiter.wait(&io.ports.listener, deadline) {
+                        return Err(NodeError::InputTimeout {
+                            from: cfg.inputs[k],
+                            step: now.0,
+                            stage: now.1,
+                            waited: cfg.stage_timeout,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Exchange `slot`: publish, then take every input's message of `slot`.
 fn exchange<S: Service, N: Stepper, H: Hooks>(
     io: &mut Hooked<'_, S, H>,
     cfg: &NodeConfig,
     stepper: &mut N,
-    inputs: &mut Inputs,
+    (inputs, held): (&mut Inputs, &mut Held),
     waiter: &mut Waiter,
     slot: Slot,
     orphan: &Orphan,
@@ -63,7 +161,10 @@ fn exchange<S: Service, N: Stepper, H: Hooks>(
         let msg = loop {
             // Take one message at a time: what stays in iceoryx2's
             // buffer holds a fast sender back (flow control).
-            if let Some(m) = io.receive(k)? {
+            if let Some(m) = held.take(io, k)? {
+                if held.resumed && (m.step, m.stage) < (n, s) {
+                    continue;
+                }
                 break m;
             }
             if waiter.polls() % 64 == 63 {

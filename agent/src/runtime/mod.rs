@@ -83,6 +83,17 @@ pub trait Stepper {
     fn link_stats(&self) -> Vec<(u32, LinkStats)> {
         Vec::new()
     }
+    /// At the start of step `step`: [`Telemetry::Crashed`] if the node's
+    /// timeline crashes it now (PROTOCOL.md § 10.10; the default: never).
+    fn crash(&self, step: u64) -> Option<Telemetry> {
+        let _ = step;
+        None
+    }
+    /// Whether the node is down (crashed): it publishes a stand-in that
+    /// nobody uses and takes nothing from its inputs.
+    fn is_down(&self) -> bool {
+        false
+    }
 }
 
 /// Why a node stopped before completing the protocol.
@@ -177,9 +188,13 @@ pub fn run_with<S: Service, N: Stepper, H: Hooks>(
     let mut io = Hooked::new(&ports, hooks, cfg.id);
     io.report(Telemetry::Ready)?;
     info!(id = cfg.id, inputs = ?cfg.inputs, outputs = ?cfg.outputs, "ready");
-    let start = match wait_command(&mut io, start_timeout, shutdown, &orphan)? {
-        Some((ControlCommand::Start, start)) => start,
-        _ => return Err(NodeError::Stopped(0)),
+    let start = match &cfg.resume {
+        // A new process of a crashed agent joins a run under way.
+        Some(_) => unix_ns_now(),
+        None => match wait_command(&mut io, start_timeout, shutdown, &orphan)? {
+            Some((ControlCommand::Start, start)) => start,
+            _ => return Err(NodeError::Stopped(0)),
+        },
     };
     info!(realtime = ?cfg.realtime, "started");
     let started_unix_ns = unix_ns_now();
@@ -229,9 +244,15 @@ pub fn run_with<S: Service, N: Stepper, H: Hooks>(
     info!(steps = cfg.steps, peak_rss_kb = done.peak_rss_kb, "done");
     // Other nodes may still be stepping: wait for Stop as long as the
     // orchestrator lives (bounded by STOP_TIMEOUT all the same).
-    match wait_command(&mut io, STOP_TIMEOUT, shutdown, &orphan)? {
-        Some((ControlCommand::Stop, _)) | None => Ok(()),
-        Some((ControlCommand::Start, _)) => Err(NodeError::Protocol("second Start".into())),
+    loop {
+        match wait_command(&mut io, STOP_TIMEOUT, shutdown, &orphan)? {
+            Some((ControlCommand::Stop, _)) | None => return Ok(()),
+            // A process that joined the run late reads the run's Start now.
+            Some((ControlCommand::Start, _)) if cfg.resume.is_some() => {}
+            Some((ControlCommand::Start, _)) => {
+                return Err(NodeError::Protocol("second Start".into()));
+            }
+        }
     }
 }
 
@@ -366,6 +387,31 @@ impl Orphan {
             self.check()?;
         }
         Ok(())
+    }
+}
+
+/// At the start of step `n`: if the node's timeline crashes it now, reports
+/// its links' counters and [`Telemetry::Crashed`], then waits to be killed
+/// (it never returns `Ok(true)`: it ends when the orchestrator kills it,
+/// or with an error when told to stop or orphaned). `Ok(false)`: no crash.
+pub(crate) fn crash_point<S: Service, N: Stepper, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
+    (cfg, inputs): (&NodeConfig, &Inputs),
+    stepper: &N,
+    n: u64,
+    (shutdown, orphan): (&AtomicBool, &Orphan),
+) -> Result<bool, NodeError> {
+    let Some(crashed) = stepper.crash(n) else {
+        return Ok(false);
+    };
+    for (from, stats) in inputs.stats(cfg, stepper.link_stats()) {
+        io.report(Telemetry::LinkStats { from, stats })?;
+    }
+    io.report(crashed)?;
+    info!(step = n, "crash point: waiting to be killed");
+    loop {
+        std::thread::sleep(ORPHAN_CHECK);
+        before_step(n, shutdown, orphan)?;
     }
 }
 

@@ -48,6 +48,14 @@ impl<S: Service> Ports<S> {
         // Services other nodes are still creating are waited for, within
         // the start timeout (PROTOCOL.md § 6.2).
         let open = Opener::new(node, run, l).patience(start_timeout);
+        let (inputs, input_services) = Self::subscribe(&open, cfg)?;
+        if cfg.resume.is_some() {
+            // The process this one replaces is dead, its ports not yet
+            // removed: ours were opened first, so that no message sent
+            // meanwhile is lost (PROTOCOL.md § 10.10); now free its place.
+            let cleaned = node.try_cleanup_dead_nodes();
+            tracing::info!(?cleaned, "took over from a crashed process");
+        }
         let own = open.state(id)?;
         let pacer = Pacer::new(l.state_buffer);
         let publisher = match cfg.realtime {
@@ -84,18 +92,6 @@ impl<S: Service> Ports<S> {
             .subscriber_builder()
             .create()
             .map_err(port("control subscriber"))?;
-        let mut inputs = Vec::new();
-        let mut input_services = Vec::new();
-        for &j in &cfg.inputs {
-            let svc = open.state(j)?;
-            inputs.push(
-                svc.subscriber_builder()
-                    .buffer_size(l.state_buffer)
-                    .create()
-                    .map_err(port("state subscriber"))?,
-            );
-            input_services.push(svc);
-        }
         let notifiers = cfg
             .outputs
             .iter()
@@ -120,6 +116,35 @@ impl<S: Service> Ports<S> {
             input_services,
             notifiers,
         })
+    }
+
+    /// A subscriber to every input, attached at once.
+    #[allow(clippy::type_complexity)]
+    fn subscribe(
+        open: &Opener<'_, S>,
+        cfg: &NodeConfig,
+    ) -> Result<
+        (
+            Vec<Subscriber<S, StateMsg, ()>>,
+            Vec<PubSub<S, StateMsg, ()>>,
+        ),
+        NodeError,
+    > {
+        let mut inputs = Vec::new();
+        let mut input_services = Vec::new();
+        for &j in &cfg.inputs {
+            let svc = open.state(j)?;
+            let sub = (svc.subscriber_builder())
+                .buffer_size(cfg.limits.state_buffer)
+                .create()
+                .map_err(port("state subscriber"))?;
+            if cfg.resume.is_some() {
+                sub.update_connections().map_err(port("connect input"))?;
+            }
+            inputs.push(sub);
+            input_services.push(svc);
+        }
+        Ok((inputs, input_services))
     }
 
     /// Readiness barrier: waits (bounded by the start timeout, and by the

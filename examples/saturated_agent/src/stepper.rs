@@ -278,6 +278,7 @@ mod tests {
                 model: Box::new(model),
                 initial,
             },
+            resume: None,
         }
     }
 

@@ -90,6 +90,11 @@ impl TelemetryCheck {
                     }
                     self.done = true;
                 }
+                Ok(Telemetry::Crashed { step, .. }) => {
+                    bad(format!(
+                        "reports a crash at step {step}: a plug-in never crashes (only a built-in agent's timeline does)"
+                    ));
+                }
                 Ok(Telemetry::LinkStats { .. } | Telemetry::Failed(_)) => {}
             }
         }

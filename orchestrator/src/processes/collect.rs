@@ -13,7 +13,8 @@
 use super::startup::POLL;
 use super::{Ports, Session};
 use crate::failure::Failure;
-use crate::outcome::Outcome;
+use crate::outcome::{Outcome, Restart};
+use attitude::agent::Carried;
 use attitude::engine::{NO_TORQUE, Snapshot};
 use attitude::guard::{self, Divergence, Envelope, Violation};
 use attitude::link::LinkStats;
@@ -74,6 +75,8 @@ pub(crate) struct NodeSlot {
     pub report: Option<Done>,
     /// It reported giving up.
     pub gave_up: bool,
+    /// When it last reported `Ready` (a new process after a crash does too).
+    pub ready_at: Option<Instant>,
 }
 
 impl NodeSlot {
@@ -90,6 +93,7 @@ impl NodeSlot {
             snapshot_peak_torque: 0.0,
             report: None,
             gave_up: false,
+            ready_at: None,
         }
     }
 }
@@ -115,6 +119,11 @@ pub(crate) struct Collector {
     pub guard: Envelope,
     /// The run's steps: the samples of this step have no torque.
     pub horizon: u64,
+    /// Nodes that reported a crash, not yet replaced: (node index, what
+    /// carries on), in arrival order.
+    pub crashes: VecDeque<(usize, Carried)>,
+    /// The processes replaced, with (node index, when the crash was booked).
+    pub restarts: Vec<(Restart, (usize, Instant))>,
 }
 
 impl Collector {
@@ -129,6 +138,8 @@ impl Collector {
             diverged: Vec::new(),
             guard: Envelope::default(),
             horizon: u64::MAX,
+            crashes: VecDeque::new(),
+            restarts: Vec::new(),
         }
     }
 
@@ -169,7 +180,15 @@ impl Collector {
     fn take(&mut self, i: usize, t: Telemetry) -> Result<(), Failure> {
         let env = self.guard;
         match t {
-            Telemetry::Ready => self.slots[i].ready = true,
+            Telemetry::Ready => {
+                self.slots[i].ready = true;
+                self.slots[i].ready_at = Some(Instant::now());
+            }
+            Telemetry::Crashed {
+                step,
+                state,
+                peak_torque,
+            } => self.take_crash(i, step, state, peak_torque)?,
             Telemetry::Sample {
                 step,
                 state,
@@ -209,7 +228,8 @@ impl Collector {
             Telemetry::Ready
             | Telemetry::Sample { .. }
             | Telemetry::LeaderSample { .. }
-            | Telemetry::Torque { .. } => {}
+            | Telemetry::Torque { .. }
+            | Telemetry::Crashed { .. } => {}
             Telemetry::LinkStats { from, stats } => self.links.push((from, slot.id, stats)),
             Telemetry::Done(d) => {
                 slot.done = true;
@@ -240,6 +260,38 @@ impl Collector {
                 }
             }
         }
+    }
+
+    /// Books node index `i`'s crash at `step` (PROTOCOL.md § 10.10): the
+    /// counters of its links it reported just before go to its new process,
+    /// which reports them, carried on, at its end.
+    fn take_crash(
+        &mut self,
+        i: usize,
+        step: u64,
+        state: AgentState,
+        peak_torque: f64,
+    ) -> Result<(), Failure> {
+        if i == 0 || guard::check_agent(&state, &self.guard).is_some() || !peak_torque.is_finite() {
+            return Err(self.sent_garbage(i, "of a crash with a state out of its envelope"));
+        }
+        let id = self.slots[i].id;
+        let (mine, rest) = std::mem::take(&mut self.links)
+            .into_iter()
+            .partition(|&(_, to, _)| to == id);
+        self.links = rest;
+        let links = mine
+            .into_iter()
+            .map(|(from, _, s)| (from, s))
+            .collect::<Vec<_>>();
+        let carried = Carried {
+            step,
+            state,
+            peak_torque,
+            links,
+        };
+        self.crashes.push_back((i, carried));
+        Ok(())
     }
 
     /// Books node index `i`'s torque `tau` of step `step` into its sample
@@ -309,7 +361,7 @@ impl Collector {
     }
 
     /// The failure of node index `i`, which sent telemetry `what`.
-    fn sent_garbage(&self, i: usize, what: &str) -> Failure {
+    pub(super) fn sent_garbage(&self, i: usize, what: &str) -> Failure {
         Failure::BrokeProtocol {
             node: self.slots[i].label.clone(),
             how: format!("it sent telemetry {what}"),
@@ -397,6 +449,14 @@ impl Collector {
                 .filter_map(|s| s.report.map(|d| (s.name.clone(), s.id, d)))
                 .collect(),
             links: self.links,
+            restarts: (self.restarts.into_iter())
+                .map(|(r, begun)| Restart {
+                    handover_ms: (self.slots[begun.0].ready_at)
+                        .filter(|&t| t > begun.1)
+                        .map(|t| (t - begun.1).as_secs_f64() * 1e3),
+                    ..r
+                })
+                .collect(),
         }
     }
 }
@@ -458,6 +518,7 @@ impl Session<'_> {
             if self.nodes.drain(&self.ports)? {
                 last_progress = Instant::now();
             }
+            self.restart_crashed()?;
             self.hand_out(on_sample, false)?;
             if !self.nodes.diverged.is_empty() {
                 // Every node finishes the step (a diverged node keeps its

@@ -103,6 +103,7 @@ pub fn node_configs(
         guard: net.guard,
         contention,
         role,
+        resume: None,
     };
     let mut out = vec![base(
         0,

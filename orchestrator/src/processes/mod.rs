@@ -16,6 +16,7 @@
 //! - `startup`: spawning the nodes, the wait for `Ready`, `Start`.
 //! - `collect`: per-node bookkeeping (one `NodeSlot` per node), telemetry into snapshots.
 //! - `blame`: which node made the run fail, and why.
+//! - `restart`: an agent's crashed process replaced by a new one.
 //! - `shutdown`: `Stop` and the exits, or killing every node.
 //! - [`crate::launch`]: a node's process, its log and the run's namespace.
 //! - [`placement`]: spread the nodes over the cores, or pack them onto one
@@ -31,6 +32,7 @@ pub mod partition;
 pub mod placement;
 pub mod ports;
 pub mod reaper;
+mod restart;
 mod shutdown;
 pub mod site;
 mod startup;

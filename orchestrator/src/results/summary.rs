@@ -162,6 +162,10 @@ pub struct Summary {
     /// Processes engine: what every node that finished reported (empty in-process).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub nodes: Vec<NodeSummary>,
+    /// Processes engine: the agents' processes that crashed and the ones
+    /// that took over (`[[event]] action = "crash"`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub restarts: Vec<crate::outcome::Restart>,
     /// In-process engine: the threads that stepped the agents (absent for
     /// the processes engine).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -12,7 +12,7 @@ use attitude::guard::Envelope;
 use attitude::link::LinkModel;
 use attitude::network::{AgentModel, AgentSpec, Neighbour, Network, Scheme};
 use attitude::reference::LeaderState;
-use attitude::timeline::{AgentTimeline, InputOutages, Outage, Repoint, Retune};
+use attitude::timeline::{AgentTimeline, Crash, InputOutages, Outage, Repoint, Retune};
 use std::collections::BTreeMap;
 
 /// Everything resolved, error-free.
@@ -40,6 +40,8 @@ pub(super) struct Timed {
     pub(super) retune: Vec<Retune>,
     /// Jumps of the constant reference, ascending: the leader's.
     pub(super) repoint: Vec<Repoint>,
+    /// Crashes by agent, ascending.
+    pub(super) crashes: BTreeMap<u32, Vec<Crash>>,
 }
 
 impl Timed {
@@ -54,6 +56,7 @@ impl Timed {
         let t = AgentTimeline {
             down,
             retune: self.retune.clone(),
+            crashes: self.crashes.get(&id).cloned().unwrap_or_default(),
         };
         (!t.is_empty()).then(|| Box::new(t))
     }

@@ -13,8 +13,9 @@ use super::graph::{Edges, LeaderLinks};
 use super::ids::Ids;
 use crate::event::{AgentAction, EventSpec, SetValue};
 use crate::schema::ReferenceKind;
+use attitude::network::Coupling;
 use attitude::network::Scheme;
-use attitude::timeline::{Outage, Repoint, Retune};
+use attitude::timeline::{Crash, Outage, Repoint, Retune};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -53,6 +54,15 @@ impl std::fmt::Display for What {
                 write!(f, "agent {agent} falls silent (removed)")
             }
             What::Resume { agent } => write!(f, "agent {agent} resumes"),
+            What::Crash { agent } => write!(f, "agent {agent} crashes"),
+            What::Restart {
+                agent,
+                initial: false,
+            } => write!(f, "agent {agent} restarts from its last state"),
+            What::Restart {
+                agent,
+                initial: true,
+            } => write!(f, "agent {agent} restarts from its initial state"),
             What::Set {
                 field,
                 value: Some(x),
@@ -90,6 +100,18 @@ pub enum What {
     Resume {
         /// The agent.
         agent: u32,
+    },
+    /// The agent's process ends.
+    Crash {
+        /// The agent.
+        agent: u32,
+    },
+    /// A new process of the agent takes over.
+    Restart {
+        /// The agent.
+        agent: u32,
+        /// From its initial state (else from its state at the crash).
+        initial: bool,
     },
     /// A field takes a new value.
     Set {
@@ -136,9 +158,27 @@ pub(super) struct World<'a> {
     pub(super) ids: &'a Ids,
     pub(super) edges: &'a Edges,
     pub(super) links: &'a LeaderLinks,
+    pub(super) coupling: Option<Coupling>,
+    /// Agents run by a plug-in (they cannot crash: the orchestrator cannot
+    /// stop a plug-in at a step).
+    pub(super) plugins: BTreeSet<u32>,
 }
 
+/// Exchanges a node may publish that a crashed one never read: the
+/// subscriber buffer of a state service (`msgs::Limits::state_buffer`),
+/// which a restart must come after.
+pub const RESTART_GAP_EXCHANGES: u64 = 64;
+
 impl World<'_> {
+    /// The fewest steps between a crash and its restart: more than
+    /// [`RESTART_GAP_EXCHANGES`] exchanges.
+    fn restart_gap(&self) -> u64 {
+        match self.coupling {
+            Some(Coupling::Sampled { every }) => (RESTART_GAP_EXCHANGES + 1) * every,
+            _ => RESTART_GAP_EXCHANGES / 4 + 1,
+        }
+    }
+
     /// The directed links `[a, b]` names: both ways for a follower edge,
     /// one for a one-way edge (either order) or a leader link; `None` if
     /// it is none of them.
@@ -252,11 +292,6 @@ fn one_action(c: &mut Ctx, k: usize, e: &EventSpec) -> bool {
     if e.state.is_some() && e.action != Some(AgentAction::Restart) {
         c.err(format!("{f}.state"), "is only for action = \"restart\"");
     }
-    if matches!(e.action, Some(AgentAction::Crash | AgentAction::Restart)) {
-        let name = e.action.map_or("", AgentAction::name);
-        c.err(format!("{f}.action"), format!("{name:?} is not implemented yet (cut, restore, silence, resume and set are); silence and resume model an agent that stops and starts talking"));
-        return false;
-    }
     if e.set
         .as_ref()
         .is_some_and(|s| SetValue::flatten(s).is_empty())
@@ -277,6 +312,8 @@ struct Walk<'a, 'w> {
     cut: BTreeMap<[u32; 2], (u64, usize, bool)>,
     /// Agents silent now: since (step, event index, forget).
     silent: BTreeMap<u32, (u64, usize, bool)>,
+    /// Agents down now: since (step, event index).
+    crashed: BTreeMap<u32, (u64, usize)>,
     scheme: Option<Scheme>,
     out: Timeline,
 }
@@ -287,6 +324,7 @@ impl<'a, 'w> Walk<'a, 'w> {
             world,
             cut: BTreeMap::new(),
             silent: BTreeMap::new(),
+            crashed: BTreeMap::new(),
             scheme: world.scheme,
             out: Timeline::default(),
         }
@@ -307,6 +345,19 @@ impl<'a, 'w> Walk<'a, 'w> {
                         hold: !forget,
                     }
                 };
+                self.out.events.push(report(what));
+            }
+        } else if let (Some(agent), Some(AgentAction::Crash | AgentAction::Restart)) =
+            (e.agent, e.action)
+        {
+            let initial = e.state == Some(crate::event::RestartState::Initial);
+            if let Some(what) = self.crash(
+                c,
+                &f,
+                agent,
+                e.action == Some(AgentAction::Restart),
+                (step, k, initial),
+            ) {
                 self.out.events.push(report(what));
             }
         } else if let (Some(agent), Some(action)) = (e.agent, e.action) {
@@ -439,6 +490,70 @@ impl<'a, 'w> Walk<'a, 'w> {
         true
     }
 
+    /// `agent = id` with `action = "crash"` (`up` false) or `"restart"`
+    /// (`up` true): its receivers' outage (holding) over the time it is
+    /// down, and its own crash.
+    fn crash(
+        &mut self,
+        c: &mut Ctx,
+        f: &str,
+        id: u32,
+        up: bool,
+        (step, k, initial): (u64, usize, bool),
+    ) -> Option<What> {
+        if !self.world.ids.contains(id) {
+            c.err(format!("{f}.agent"), format!("agent {id} does not exist"));
+            return None;
+        }
+        let field = format!("{f}.action");
+        if self.world.plugins.contains(&id) {
+            c.err(field, format!("agent {id} is a plug-in: only a built-in agent can crash and restart (the orchestrator cannot stop a plug-in at a step; silence and resume model a plug-in that stops talking)"));
+            return None;
+        }
+        let t = step as f64 * self.world.dt;
+        if !up {
+            if let Some(&(_, since)) = self.crashed.get(&id) {
+                c.err(
+                    field,
+                    format!("agent {id} is down already (event[{since}])"),
+                );
+                return None;
+            }
+            self.crashed.insert(id, (step, k));
+            return Some(What::Crash { agent: id });
+        }
+        let Some((from, _)) = self.crashed.remove(&id) else {
+            c.err(field, format!("agent {id} has not crashed by t = {t} s"));
+            return None;
+        };
+        let gap = self.world.restart_gap();
+        if step - from < gap {
+            c.err(field, format!("restarts agent {id} {} steps after its crash: a restart comes at least {gap} steps ({} s) after it, more than {RESTART_GAP_EXCHANGES} exchanges (what the crashed process may have left unread in its buffers)", step - from, gap as f64 * self.world.dt));
+            return None;
+        }
+        if let Some(Coupling::Sampled { every }) = self.world.coupling
+            && step % every != 0
+        {
+            c.err(field, format!("restarts agent {id} at step {step}, between exchanges: with coupling = \"sampled\" a restart falls on an exchange (a multiple of {every} steps)"));
+            return None;
+        }
+        self.down(
+            &self.world.arcs_out(id),
+            Outage {
+                from,
+                to: step,
+                forget: false,
+            },
+        );
+        let crash = Crash {
+            from,
+            to: Some(step),
+            initial,
+        };
+        self.out.timed.crashes.entry(id).or_default().push(crash);
+        Some(What::Restart { agent: id, initial })
+    }
+
     /// `set` of `path` (its field in the file: `field`) to `value`: a
     /// scheme gain or the constant reference.
     fn set(
@@ -510,6 +625,23 @@ impl<'a, 'w> Walk<'a, 'w> {
         for (id, since) in std::mem::take(&mut self.silent) {
             let arcs = self.world.arcs_out(id);
             self.down(&arcs, open(since));
+        }
+        for (id, (from, _)) in std::mem::take(&mut self.crashed) {
+            let arcs = self.world.arcs_out(id);
+            self.down(
+                &arcs,
+                Outage {
+                    from,
+                    to: end,
+                    forget: false,
+                },
+            );
+            let crash = Crash {
+                from,
+                to: None,
+                initial: false,
+            };
+            self.out.timed.crashes.entry(id).or_default().push(crash);
         }
         for outages in self.out.timed.down.values_mut() {
             *outages = merged(std::mem::take(outages));

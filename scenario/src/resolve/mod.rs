@@ -159,6 +159,11 @@ pub fn resolve_with(s: &Scenario, check: StiffnessCheck) -> Result<Resolved, Vec
         ids: &ids,
         edges: &edges,
         links: &links,
+        coupling: time.coupling,
+        plugins: (s.agents.iter())
+            .filter(|a| a.command.is_some())
+            .map(|a| a.id)
+            .collect(),
     };
     let timeline = events::events(&mut c, &s.events, &world);
     if !c.errors.is_empty() {
