@@ -81,7 +81,8 @@ fn margins(scenarios: &Path, reps: usize) -> anyhow::Result<String> {
     Ok(s)
 }
 
-fn options(out: PathBuf, until: Until) -> RunOptions {
+/// In-process options of a run into `out` with `until` (no progress, one thread).
+pub(crate) fn options(out: PathBuf, until: Until) -> RunOptions {
     RunOptions {
         engine: Engine::InProcess,
         out,

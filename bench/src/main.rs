@@ -42,6 +42,7 @@ mod error;
 mod hosts;
 mod measure;
 mod procs;
+mod restart;
 mod ring;
 mod scale;
 mod stats;
@@ -111,6 +112,22 @@ enum Cmd {
         /// Repetitions per measurement (medians).
         #[arg(long, default_value_t = 3)]
         reps: usize,
+    },
+    /// Issue 35: what a crash and restart of an agent costs in the process
+    /// engine (the paper's observerless run with and without, a Markdown table).
+    Restart {
+        /// Directory of the paper scenarios (default: scenarios/paper).
+        #[arg(long)]
+        scenarios: Option<PathBuf>,
+        /// Repetitions per measurement (medians).
+        #[arg(long, default_value_t = 5)]
+        reps: usize,
+        /// Simulated seconds of every run.
+        #[arg(long, default_value_t = 20.0)]
+        duration: f64,
+        /// Crashes and restarts per run.
+        #[arg(long, default_value_t = 4)]
+        restarts: usize,
     },
     /// In-process scale: agent-steps/s of the in-process engine against N
     /// agents and threads, per scheme (networks built in memory; a Markdown table).
@@ -251,6 +268,16 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
         Cmd::Conclusions { scenarios, reps } => {
             let dir = scenarios.unwrap_or_else(|| PathBuf::from("scenarios/paper"));
             print!("{}", conclusions::report(&dir, reps)?);
+            Ok(())
+        }
+        Cmd::Restart {
+            scenarios,
+            reps,
+            duration,
+            restarts,
+        } => {
+            let dir = scenarios.unwrap_or_else(|| PathBuf::from("scenarios/paper"));
+            print!("{}", restart::report(&dir, reps, duration, restarts)?);
             Ok(())
         }
         Cmd::Hosts {

@@ -637,7 +637,7 @@ mod tests {
             assert_eq!(TelemetryKind::of_code(kind as u32), Some(kind));
         }
         assert_eq!(TelemetryKind::of_code(0), None);
-        assert_eq!(TelemetryKind::of_code(8), None);
+        assert_eq!(TelemetryKind::of_code(9), None);
     }
 
     #[test]

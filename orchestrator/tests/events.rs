@@ -321,9 +321,9 @@ fn bad_events_are_refused_naming_the_event() {
             "event[0].set: sets nothing",
         ),
         (
-            "crash",
-            "[[event]]\nt = 1.0\nagent = 2\naction = \"crash\"\n",
-            "\"crash\" is not implemented yet",
+            "restart-without-crash",
+            "[[event]]\nt = 1.0\nagent = 2\naction = \"restart\"\n",
+            "event[0].action: agent 2 has not crashed by t = 1 s",
         ),
         (
             "hold-on-restore",

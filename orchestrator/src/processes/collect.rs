@@ -75,8 +75,6 @@ pub(crate) struct NodeSlot {
     pub report: Option<Done>,
     /// It reported giving up.
     pub gave_up: bool,
-    /// When it last reported `Ready` (a new process after a crash does too).
-    pub ready_at: Option<Instant>,
 }
 
 impl NodeSlot {
@@ -93,7 +91,6 @@ impl NodeSlot {
             snapshot_peak_torque: 0.0,
             report: None,
             gave_up: false,
-            ready_at: None,
         }
     }
 }
@@ -182,7 +179,10 @@ impl Collector {
         match t {
             Telemetry::Ready => {
                 self.slots[i].ready = true;
-                self.slots[i].ready_at = Some(Instant::now());
+                let restarted = self.restarts.iter_mut().rev().find(|(_, (j, _))| *j == i);
+                if let Some((r, (_, begun))) = restarted.filter(|(r, _)| r.handover_ms.is_none()) {
+                    r.handover_ms = Some(begun.elapsed().as_secs_f64() * 1e3);
+                }
             }
             Telemetry::Crashed {
                 step,
@@ -449,14 +449,7 @@ impl Collector {
                 .filter_map(|s| s.report.map(|d| (s.name.clone(), s.id, d)))
                 .collect(),
             links: self.links,
-            restarts: (self.restarts.into_iter())
-                .map(|(r, begun)| Restart {
-                    handover_ms: (self.slots[begun.0].ready_at)
-                        .filter(|&t| t > begun.1)
-                        .map(|t| (t - begun.1).as_secs_f64() * 1e3),
-                    ..r
-                })
-                .collect(),
+            restarts: self.restarts.into_iter().map(|(r, _)| r).collect(),
         }
     }
 }
