@@ -1,0 +1,217 @@
+"""attsync from Python: load a scenario, run it on the in-process engine
+(or the process engine), and read the results as pandas DataFrames and
+numpy arrays. docs/python.md is the manual.
+
+    import attsync
+    sc = attsync.load("scenarios/paper/timevarying.toml").set("simulation.duration", 10)
+    run = attsync.run(sc)
+    run.errors            # DataFrame: errors.csv
+    run.states.R.shape    # (time, agent, 3, 3)
+    run.summary["verdict"]
+
+A run is the CLI's own (`attsync run`), called directly: its results
+directory is byte-identical to the CLI's.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tempfile
+from pathlib import Path
+from typing import Any, Optional
+
+import pandas as pd
+
+from . import _attsync
+from .states import States, StatesFormatError, read_states
+
+__all__ = [
+    "Run",
+    "RunError",
+    "Scenario",
+    "ScenarioError",
+    "States",
+    "StatesFormatError",
+    "load",
+    "open",
+    "read_states",
+    "run",
+]
+
+__version__ = _attsync.__version__
+
+#: A run that could not start or did not complete (``exit_code`` as the CLI's).
+RunError = _attsync.RunError
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be read or is not valid.
+
+    ``file`` is the scenario file; ``issues`` every problem as ``(field,
+    reason)`` (the field in the file's TOML path, ``--set SPEC`` for an
+    override that does not apply); ``field`` and ``reason`` are the first's.
+    """
+
+    def __init__(self, message: str, file: str, issues: list):
+        super().__init__(message)
+        self.file = file
+        self.issues = [tuple(i) for i in issues]
+        self.field, self.reason = self.issues[0] if self.issues else ("", message)
+
+
+def _native(f, *args, **kwargs):
+    """Calls the native ``f``, its scenario errors as :class:`ScenarioError`."""
+    try:
+        return f(*args, **kwargs)
+    except _attsync.ScenarioError as e:
+        message, file, issues = e.args
+        raise ScenarioError(message, file, issues) from None
+
+
+def _toml_value(v: Any) -> str:
+    """``v`` as a TOML value (what ``--set FIELD=VALUE`` reads)."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return repr(v)
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{json.dumps(str(k))} = {_toml_value(x)}" for k, x in v.items()) + " }"
+    if hasattr(v, "tolist"):  # numpy arrays and scalars
+        return _toml_value(v.tolist())
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(f"cannot set a value of type {type(v).__name__} (numbers, booleans, strings, lists, dicts)")
+
+
+class Scenario:
+    """A scenario file with overrides, validated at every change.
+
+    ``set`` takes the same field paths as ``attsync run --set`` and is
+    checked the same way: an error raises :class:`ScenarioError` naming the
+    file, the field and the reason, and leaves the scenario as it was.
+    """
+
+    def __init__(self, path, sets: Optional[list] = None):
+        self.path = Path(path)
+        self.sets = list(sets or [])
+        self.name, self.warnings = _native(_attsync.check, str(self.path), self.sets)
+
+    def set(self, field: str, value: Any) -> "Scenario":
+        """Sets ``field`` (a path such as ``simulation.duration`` or
+        ``agent[2].omega``) to ``value``; returns the scenario (chainable)."""
+        spec = f"{field}={_toml_value(value)}"
+        name, warnings = _native(_attsync.check, str(self.path), self.sets + [spec])
+        self.sets.append(spec)
+        self.name, self.warnings = name, warnings
+        return self
+
+    def to_toml(self) -> str:
+        """The effective scenario (the file with every override), as TOML."""
+        return _native(_attsync.effective_toml, str(self.path), self.sets)
+
+    def __repr__(self) -> str:
+        sets = "".join(f" --set {s}" for s in self.sets)
+        return f"<attsync.Scenario {self.name}: {self.path}{sets}>"
+
+
+def load(path) -> Scenario:
+    """Loads and validates the scenario file at ``path``."""
+    return Scenario(path)
+
+
+class Run:
+    """A run's results directory, read lazily: ``errors``, ``states``,
+    ``torques``, ``summary``."""
+
+    def __init__(self, directory, _keep=None):
+        self.dir = Path(directory)
+        if not (self.dir / "summary.json").is_file():
+            raise FileNotFoundError(f"{self.dir}: not a results directory (no summary.json)")
+        self._keep = _keep  # a temporary directory that lives as long as this run
+        self._errors = None
+        self._states = None
+        self._summary = None
+
+    @property
+    def summary(self) -> dict:
+        """``summary.json``."""
+        if self._summary is None:
+            self._summary = json.loads((self.dir / "summary.json").read_text())
+        return self._summary
+
+    @property
+    def errors(self) -> pd.DataFrame:
+        """``errors.csv``: one row per sample, its columns."""
+        if self._errors is None:
+            self._errors = pd.read_csv(self.dir / "errors.csv", float_precision="round_trip")
+        return self._errors
+
+    @property
+    def states(self) -> States:
+        """``states.bin`` as numpy arrays (:class:`States`)."""
+        if self._states is None:
+            self._states = read_states(self.dir / "states.bin")
+        return self._states
+
+    @property
+    def torques(self) -> pd.DataFrame:
+        """The torque each agent applied at each sample (``t``, ``agent``,
+        ``tau1``–``tau3``, N·m, body frame); NaN where none was applied (after
+        the last step, while an agent is down) or a plug-in did not report it."""
+        s = self.states
+        T, n = s.tau.shape[:2]
+        return pd.DataFrame(
+            {
+                "t": s.t.repeat(n),
+                "agent": list(s.agent_ids) * T,
+                "tau1": s.tau[:, :, 0].ravel(),
+                "tau2": s.tau[:, :, 1].ravel(),
+                "tau3": s.tau[:, :, 2].ravel(),
+            }
+        )
+
+    @property
+    def complete(self) -> bool:
+        """Whether the run reached its horizon (``summary["complete"]``)."""
+        return bool(self.summary.get("complete"))
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return f"<attsync.Run {s.get('scenario')} ({s.get('engine')}, t = {s.get('t_end')} s): {self.dir}>"
+
+
+def run(scenario, engine: str = "in-process", threads: Optional[int] = None, out=None) -> Run:
+    """Runs ``scenario`` (a :class:`Scenario` or a path) as ``attsync run``
+    does, on ``engine`` (``"in-process"`` or ``"processes"``).
+
+    ``out``: the results directory to write (as ``--out``; then ``attsync
+    verify`` accepts it); without it the results go to a temporary directory
+    removed with the returned :class:`Run`. A run that stops early (it
+    diverged, a node failed, Ctrl-C) still returns its results so far:
+    ``Run.complete`` is false and ``Run.summary["incomplete_reason"]`` says
+    why (Ctrl-C then raises ``KeyboardInterrupt``); a run that cannot start
+    raises :class:`RunError`.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load(scenario)
+    keep = None
+    if out is None:
+        keep = tempfile.TemporaryDirectory(prefix="attsync-")
+        out = Path(keep.name) / "results"
+    _native(_attsync.run, str(scenario.path), scenario.sets, Path(out), engine, threads)
+    return Run(out, _keep=keep)
+
+
+def open(results_dir) -> Run:  # noqa: A001 (the API's name)
+    """Reads a results directory written by ``attsync run`` or :func:`run`."""
+    return Run(results_dir)
+

@@ -1,0 +1,162 @@
+//! `attsync._attsync`: the native module of the `attsync` Python package
+//! (`python/attsync/`, built by maturin). It calls the orchestrator's
+//! library directly: a scenario is loaded and validated exactly as
+//! `attsync check`/`--set` do, and a run is `attsync::run::run`, the CLI's
+//! own, so its results directory is byte-identical to the CLI's. The
+//! Python layer reads the results into pandas and numpy.
+//!
+//! Errors cross as exceptions, never as panics: [`ScenarioError`] carries
+//! the file and every `(field, reason)`; a run that fails is a
+//! [`RunError`]; Ctrl-C stops a run cleanly (its results kept) and raises
+//! `KeyboardInterrupt`.
+
+use attsync::interrupt::Interrupt;
+use attsync::processes::ProcessOptions;
+use attsync::run::{Engine, Judging, RunOptions};
+use attsync::scenario::{self, Loaded};
+use attsync::until::{DEFAULT_TOLERANCE, Until};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+create_exception!(
+    _attsync,
+    ScenarioError,
+    PyValueError,
+    "A scenario that cannot be read or is not valid: `args` are (message, file, [(field, reason), …])."
+);
+create_exception!(
+    _attsync,
+    RunError,
+    PyRuntimeError,
+    "A run that could not start or did not complete: `args` are (message, exit code)."
+);
+
+/// The Python exception of a scenario error.
+fn scenario_error(e: &scenario::ScenarioError) -> PyErr {
+    use scenario::ScenarioError as E;
+    let (file, issues): (&Path, Vec<(String, String)>) = match e {
+        E::Io { file, error } => (file, vec![(String::new(), error.to_string())]),
+        E::Parse { file, issues } | E::Override { file, issues } | E::Invalid { file, issues } => (
+            file,
+            (issues.iter())
+                .map(|i| (i.field.clone(), i.reason.clone()))
+                .collect(),
+        ),
+    };
+    ScenarioError::new_err((e.to_string(), file.display().to_string(), issues))
+}
+
+/// `path` with the overrides `sets` (`FIELD=VALUE`, as `--set`), loaded and
+/// validated.
+fn load(path: &str, sets: &[String]) -> PyResult<Loaded> {
+    scenario::load(Path::new(path), sets).map_err(|e| scenario_error(&e))
+}
+
+/// Validates `path` with `sets`; returns the scenario's name and its
+/// warnings.
+#[pyfunction]
+fn check(path: &str, sets: Vec<String>) -> PyResult<(String, Vec<String>)> {
+    let loaded = load(path, &sets)?;
+    let warnings = loaded
+        .resolved
+        .warnings
+        .iter()
+        .map(|w| w.to_string())
+        .collect();
+    Ok((loaded.name(), warnings))
+}
+
+/// The effective TOML of `path` with `sets` (what a run writes as `scenario.toml`).
+#[pyfunction]
+fn effective_toml(path: &str, sets: Vec<String>) -> PyResult<String> {
+    let loaded = load(path, &sets)?;
+    toml::to_string(&loaded.document).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+/// Runs `path` with `sets` on `engine` (`"in-process"` or `"processes"`)
+/// with `threads` into `out`, as `attsync run --out OUT` does; returns
+/// `summary.json`'s text. The GIL is released while it runs; Ctrl-C stops
+/// it as SIGINT stops the CLI (the results so far are kept) and raises
+/// `KeyboardInterrupt`.
+#[pyfunction]
+#[pyo3(signature = (path, sets, out, engine="in-process", threads=None))]
+fn run(
+    py: Python<'_>,
+    path: &str,
+    sets: Vec<String>,
+    out: PathBuf,
+    engine: &str,
+    threads: Option<usize>,
+) -> PyResult<String> {
+    let loaded = load(path, &sets)?;
+    let engine = match engine {
+        "in-process" => Engine::InProcess,
+        "processes" => Engine::Processes,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "engine must be \"in-process\" or \"processes\", not {other:?}"
+            )));
+        }
+    };
+    let opts = RunOptions {
+        engine,
+        out,
+        processes: ProcessOptions::default(),
+        progress: false,
+        threads: threads.unwrap_or_else(attsync::run::default_threads),
+        view: true,
+        hosts: None,
+        judging: Judging {
+            tolerance: DEFAULT_TOLERANCE,
+            until: Until::Horizon,
+        },
+    };
+    let interrupt = Interrupt::new();
+    let ran = watched(py, &interrupt, || {
+        attsync::run::run(&loaded, &opts, &interrupt)
+    })?;
+    let summary = ran.map_err(|e| RunError::new_err((e.to_string(), e.exit_code())))?;
+    if interrupt.is_set() {
+        return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+            "the run was interrupted; its results so far are kept",
+        ));
+    }
+    serde_json::to_string(&summary).map_err(|e| RunError::new_err((e.to_string(), 1u8)))
+}
+
+/// Runs `work` on a thread of its own without the GIL while this thread
+/// looks for Python's signals every 50 ms: a pending one (Ctrl-C) raises
+/// `interrupt`, so that `work` stops as the CLI would on SIGINT.
+fn watched<T: Send>(
+    py: Python<'_>,
+    interrupt: &Interrupt,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    std::thread::scope(|s| {
+        let handle = s.spawn(work);
+        while !handle.is_finished() {
+            py.detach(|| std::thread::sleep(Duration::from_millis(50)));
+            if py.check_signals().is_err() {
+                interrupt.trigger(2);
+            }
+        }
+        handle
+            .join()
+            .map_err(|_| PyRuntimeError::new_err("the run panicked (a bug in attsync)"))
+    })
+}
+
+/// The module.
+#[pymodule]
+fn _attsync(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(effective_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
+    m.add("RunError", m.py().get_type::<RunError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
