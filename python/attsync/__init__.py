@@ -34,9 +34,12 @@ __all__ = [
     "States",
     "StatesFormatError",
     "load",
+    "margin",
+    "mc",
     "open",
     "read_states",
     "run",
+    "sweep",
 ]
 
 __version__ = _attsync.__version__
@@ -215,3 +218,53 @@ def open(results_dir) -> Run:  # noqa: A001 (the API's name)
     """Reads a results directory written by ``attsync run`` or :func:`run`."""
     return Run(results_dir)
 
+
+
+def _scenario(scenario) -> Scenario:
+    return scenario if isinstance(scenario, Scenario) else load(scenario)
+
+
+def _table(native, scenario, out, csv_name, *args, **kwargs) -> pd.DataFrame:
+    """Runs ``native`` into ``out`` (a temporary directory if None) and reads
+    its ``csv_name``; the directory is in ``DataFrame.attrs["dir"]`` when kept."""
+    sc = _scenario(scenario)
+    keep = None
+    if out is None:
+        keep = tempfile.TemporaryDirectory(prefix="attsync-")
+        out = Path(keep.name) / "results"
+    try:
+        _native(native, str(sc.path), sc.sets, *args, Path(out), **kwargs)
+        df = pd.read_csv(Path(out) / csv_name, float_precision="round_trip")
+    finally:
+        if keep is not None:
+            keep.cleanup()
+    if keep is None:
+        df.attrs["dir"] = str(out)
+    return df
+
+
+def sweep(scenario, param: str, values, engine: str = "in-process", out=None, grid=None,
+          jobs: Optional[int] = None, find_margin: bool = False) -> pd.DataFrame:
+    """``attsync sweep``: one run per value of ``param`` (and, with ``grid =
+    (param2, values2)``, per pair: the stability chart); the rows of
+    ``sweep.csv`` (verdict, decay rate, settle time per value).
+    ``find_margin`` bisects for the first value that does not converge (each
+    run then goes on until its verdict is final)."""
+    second = None if grid is None else (grid[0], [_toml_value(v) for v in grid[1]])
+    return _table(_attsync.sweep, scenario, out, "sweep.csv", param, [_toml_value(v) for v in values],
+                  grid=second, engine=engine, jobs=jobs, find_margin=find_margin)
+
+
+def mc(scenario, trials: int, seed: int = 0, engine: str = "in-process", out=None,
+       jobs: Optional[int] = None) -> pd.DataFrame:
+    """``attsync mc``: ``trials`` runs with initial conditions (and the
+    scenario's ``[[monte_carlo.param]]`` fields) drawn from ``seed``; the
+    rows of ``trials.csv`` (one per trial: its draws, verdict, settle time)."""
+    return _table(_attsync.mc, scenario, out, "trials.csv", int(trials), int(seed), engine=engine, jobs=jobs)
+
+
+def margin(scenario) -> dict:
+    """``attsync margin --json``: the exact delay margin of the scenario's
+    linearisation (docs/verdicts.md)."""
+    sc = _scenario(scenario)
+    return json.loads(_native(_attsync.margin, str(sc.path), sc.sets))

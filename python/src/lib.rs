@@ -92,15 +92,7 @@ fn run(
     threads: Option<usize>,
 ) -> PyResult<String> {
     let loaded = load(path, &sets)?;
-    let engine = match engine {
-        "in-process" => Engine::InProcess,
-        "processes" => Engine::Processes,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "engine must be \"in-process\" or \"processes\", not {other:?}"
-            )));
-        }
-    };
+    let engine = engine_of(engine)?;
     let opts = RunOptions {
         engine,
         out,
@@ -125,6 +117,145 @@ fn run(
         ));
     }
     serde_json::to_string(&summary).map_err(|e| RunError::new_err((e.to_string(), 1u8)))
+}
+
+/// The engine named `name`.
+fn engine_of(name: &str) -> PyResult<Engine> {
+    match name {
+        "in-process" => Ok(Engine::InProcess),
+        "processes" => Ok(Engine::Processes),
+        other => Err(PyValueError::new_err(format!(
+            "engine must be \"in-process\" or \"processes\", not {other:?}"
+        ))),
+    }
+}
+
+/// `attsync sweep PATH --param P --values V… [--param P2 --values V2…]
+/// [--find-margin] --out OUT` with `sets`; values are TOML literals.
+#[pyfunction]
+#[pyo3(signature = (path, sets, param, values, out, grid=None, engine="in-process", jobs=None, find_margin=false))]
+#[allow(clippy::too_many_arguments)]
+fn sweep(
+    py: Python<'_>,
+    path: &str,
+    sets: Vec<String>,
+    param: String,
+    values: Vec<String>,
+    out: PathBuf,
+    grid: Option<(String, Vec<String>)>,
+    engine: &str,
+    jobs: Option<usize>,
+    find_margin: bool,
+) -> PyResult<()> {
+    use attsync::sweep::{self as sw, Axis, Bisection, SweepOptions};
+    let base = load(path, &sets)?;
+    let net = &base.resolved.network;
+    let engine = engine_of(engine)?;
+    let nodes = net.agents.len() + 1;
+    let (jobs, threads) = match jobs {
+        Some(j) => sw::jobs_and_threads(Some(j), None),
+        None => (sw::default_jobs(engine, nodes, sw::cores()), 1),
+    };
+    let until = if find_margin {
+        Until::Settled {
+            max_duration: attsync::until::DEFAULT_MAX_FACTOR * net.steps as f64 * net.dt,
+        }
+    } else {
+        Until::Horizon
+    };
+    let o = SweepOptions {
+        scenario: PathBuf::from(path),
+        param,
+        values,
+        grid: grid.map(|(param, values)| Axis { param, values }),
+        jobs,
+        set: sets,
+        run: RunOptions {
+            engine,
+            out,
+            processes: ProcessOptions::default(),
+            progress: false,
+            threads,
+            view: false,
+            hosts: None,
+            judging: Judging {
+                tolerance: DEFAULT_TOLERANCE,
+                until,
+            },
+        },
+        find_margin: find_margin.then_some(Bisection {
+            iterations: 8,
+            quantum: None,
+        }),
+        stiffness: scenario::StiffnessCheck::Refuse,
+    };
+    let interrupt = Interrupt::new();
+    let swept = watched(py, &interrupt, || sw::sweep(&o, &interrupt))?;
+    match swept {
+        Ok(_) => Ok(()),
+        Err(sw::SweepError::Scenario(e)) => Err(scenario_error(&e)),
+        Err(e) => Err(RunError::new_err((e.to_string(), e.exit_code()))),
+    }
+}
+
+/// `attsync mc PATH --trials N --seed S --out OUT` with `sets`.
+#[pyfunction]
+#[pyo3(signature = (path, sets, trials, seed, out, engine="in-process", jobs=None))]
+#[allow(clippy::too_many_arguments)]
+fn mc(
+    py: Python<'_>,
+    path: &str,
+    sets: Vec<String>,
+    trials: u64,
+    seed: u64,
+    out: PathBuf,
+    engine: &str,
+    jobs: Option<usize>,
+) -> PyResult<()> {
+    use attsync::mc::{self as m, McOptions};
+    let base = load(path, &sets)?;
+    let engine = engine_of(engine)?;
+    let nodes = base.resolved.network.agents.len() + 1;
+    let o = McOptions {
+        scenario: PathBuf::from(path),
+        set: sets,
+        trials,
+        seed,
+        jobs: jobs.unwrap_or_else(|| {
+            attsync::sweep::default_jobs(engine, nodes, attsync::sweep::cores())
+        }),
+        engine,
+        processes: ProcessOptions::default(),
+        judging: Judging {
+            tolerance: DEFAULT_TOLERANCE,
+            until: Until::Horizon,
+        },
+        out,
+        progress: false,
+        stiffness: scenario::StiffnessCheck::Refuse,
+    };
+    let interrupt = Interrupt::new();
+    match watched(py, &interrupt, || m::monte_carlo(&o, &interrupt))? {
+        Ok(_) => Ok(()),
+        Err(m::McError::Scenario(e)) => Err(scenario_error(&e)),
+        Err(e) => Err(RunError::new_err((e.to_string(), e.exit_code()))),
+    }
+}
+
+/// `attsync margin PATH --json` with `sets`: the delay margin of the
+/// linearisation, as JSON text.
+#[pyfunction]
+fn margin(path: &str, sets: Vec<String>) -> PyResult<String> {
+    let loaded = load(path, &sets)?;
+    let report = attsync::margin::margin(&loaded).map_err(|e| {
+        let field = e.field.unwrap_or("").to_string();
+        ScenarioError::new_err((
+            e.to_string(),
+            e.file.display().to_string(),
+            vec![(field, e.reason.to_string())],
+        ))
+    })?;
+    serde_json::to_string(&report.json()).map_err(|e| RunError::new_err((e.to_string(), 1u8)))
 }
 
 /// Runs `work` on a thread of its own without the GIL while this thread
@@ -155,6 +286,9 @@ fn _attsync(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(effective_toml, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(mc, m)?)?;
+    m.add_function(wrap_pyfunction!(margin, m)?)?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

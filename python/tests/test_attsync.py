@@ -155,3 +155,42 @@ def test_a_diverging_run_returns_what_it_recorded(tmp_path):
     assert r.summary["diverged"]["quantity"] == "omega"
     assert r.summary["diverged"]["value"] > 7.0
     assert list(r.errors.columns)[:3] == ["t", "agent", "att_err"]
+
+
+def _cli_csv(path):
+    return pd.read_csv(path, float_precision="round_trip")
+
+
+def test_sweep_is_the_clis_sweep_csv(tmp_path):
+    sc = short(OBSERVERLESS, duration=2)
+    df = attsync.sweep(sc, "network.delay", [0, 0.05, 0.1], out=tmp_path / "py")
+    assert list(df["value"]) == [0, 0.05, 0.1]
+    assert df.attrs["dir"] == str(tmp_path / "py")
+    o = cli("sweep", OBSERVERLESS, "--param", "network.delay", "--values", "0,0.05,0.1",
+            "--set", "simulation.duration=2", "--out", tmp_path / "cli")
+    assert o.returncode == 0, o.stderr
+    pd.testing.assert_frame_equal(df, _cli_csv(tmp_path / "cli" / "sweep.csv"))
+    grid = attsync.sweep(sc, "network.delay", [0, 0.1], grid=("scheme.control.k_r", [1.0, 2.0]))
+    assert len(grid) == 4 and "dir" not in grid.attrs
+
+
+def test_mc_is_the_clis_trials_csv(tmp_path):
+    sc = short(OBSERVERLESS, duration=1)
+    df = attsync.mc(sc, 6, seed=11, out=tmp_path / "py")
+    assert list(df["trial"]) == list(range(6))
+    o = cli("mc", OBSERVERLESS, "--trials", "6", "--seed", "11", "--set", "simulation.duration=1",
+            "--out", tmp_path / "cli")
+    assert o.returncode == 0, o.stderr
+    ours, theirs = df, _cli_csv(tmp_path / "cli" / "trials.csv")
+    pd.testing.assert_frame_equal(ours, theirs)
+
+
+def test_margin_is_the_clis(tmp_path):
+    m = attsync.margin(OBSERVERLESS)
+    o = cli("margin", OBSERVERLESS, "--json", tmp_path / "m.json")
+    assert o.returncode == 0, o.stderr
+    import json
+
+    theirs = json.loads((tmp_path / "m.json").read_text())
+    assert m["margin"] == theirs["margin"]
+    assert m["kind"] == "crossing" and abs(m["margin"] - 0.389) < 1e-3
