@@ -17,6 +17,7 @@ use crate::effects::{At, Body, EffectsState, Ideal};
 use crate::guard::{self, Envelope, Violation};
 use crate::integrate::stage_time_fraction;
 use crate::integrate::{LieDerivative, LieState, Stages, Start};
+use crate::law::{Law, LawInput, SharedLaw};
 use crate::link::{Link, LinkModel, LinkStats};
 use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
 use crate::observer::{
@@ -38,7 +39,8 @@ use serde::{Deserialize, Serialize};
 /// the agent hears the leader. `body` is the body's effects at this stage
 /// ([`Ideal`] unless `model.effects` is set): the law measures `x` through
 /// its sensors and assumes `Ĵᵢ`, the body receives `sat(τᵢ) + dᵢ(t)`
-/// ([`crate::effects`]).
+/// ([`crate::effects`]). With `external`, its law replaces the scheme's
+/// torque ([`crate::law`]).
 #[must_use]
 pub fn agent_field<B: Body>(
     model: &AgentModel,
@@ -46,7 +48,7 @@ pub fn agent_field<B: Body>(
     x: &AgentState,
     nbrs: &[Exchanged],
     leader: Option<&Exchanged>,
-    body: &B,
+    (body, external): (&B, Option<&External<'_>>),
 ) -> (AgentDerivative, Vector3<f64>) {
     let leader = match (leader, &model.leader_gain) {
         (Some(x), Some(a)) => Some(LeaderInput { a, x }),
@@ -83,6 +85,15 @@ pub fn agent_field<B: Body>(
             (Vector3::zeros(), Vector3::zeros(), tau)
         }
     };
+    let tau = match external {
+        Some(e) => e.torque(
+            model,
+            (m, &w_hat_dot),
+            (gains, nbrs, leader.as_ref()),
+            &inertia.j,
+        ),
+        None => tau,
+    };
     let tau = body.actuate(tau);
     let body_tau = match body.disturbance(&x.r) {
         Some(d) => tau + d,
@@ -104,6 +115,51 @@ pub fn agent_field<B: Body>(
     (d, tau)
 }
 
+/// A law given from outside ([`crate::law`]) and the stage it is called at.
+#[derive(Debug, Clone, Copy)]
+pub struct External<'a> {
+    /// The law.
+    pub law: &'a dyn Law,
+    /// The step.
+    pub step: u64,
+    /// The stage.
+    pub stage: usize,
+    /// The step size, s.
+    pub dt: f64,
+}
+
+impl External<'_> {
+    /// The law's torque for agent `model` measuring `m` (with `ω̂̇`), hearing
+    /// `nbrs` with `gains` and `leader`, assuming `inertia`.
+    fn torque(
+        &self,
+        model: &AgentModel,
+        (m, w_hat_dot): (&AgentState, &Vector3<f64>),
+        (gains, nbrs, leader): (&[Matrix3<f64>], &[Exchanged], Option<&LeaderInput<'_>>),
+        inertia: &Matrix3<f64>,
+    ) -> Vector3<f64> {
+        let control = match &model.scheme {
+            Scheme::ObserverTimeVarying { control, .. }
+            | Scheme::ObserverConstant { control, .. }
+            | Scheme::Observerless { control } => control,
+        };
+        self.law.torque(&LawInput {
+            agent: model.id,
+            step: self.step,
+            stage: self.stage,
+            t: (self.step as f64 + stage_time_fraction(self.stage)) * self.dt,
+            dt: self.dt,
+            state: m,
+            w_hat_dot,
+            gains,
+            neighbours: nbrs,
+            leader: leader.map(|l| (l.a, l.x)),
+            k: (control.k_r, control.k_w),
+            inertia,
+        })
+    }
+}
+
 /// [`agent_field`] with the inputs `absent` says are out left out of
 /// every sum (the leader: as if the agent did not hear it).
 fn without<B: Body>(
@@ -113,7 +169,7 @@ fn without<B: Body>(
     nbrs: &[Exchanged],
     leader: Option<&Exchanged>,
     absent: &mut Absent,
-    body: &B,
+    body: (&B, Option<&External<'_>>),
 ) -> (AgentDerivative, Vector3<f64>) {
     absent.keep(gains, nbrs);
     let leader = leader.filter(|_| !absent.leader(gains.len()));
@@ -126,23 +182,28 @@ fn field(
     (model, gains, x): (&AgentModel, &[Matrix3<f64>], &AgentState),
     nbrs: &[Exchanged],
     leader: Option<&Exchanged>,
-    absent: Option<&mut Absent>,
-    at: Option<&At<'_>>,
+    (absent, at, ext): (Option<&mut Absent>, Option<&At<'_>>, Option<&External<'_>>),
 ) -> (AgentDerivative, Vector3<f64>) {
     match (absent, at) {
-        (None, None) => agent_field(model, gains, x, nbrs, leader, &Ideal),
-        (None, Some(b)) => agent_field(model, gains, x, nbrs, leader, b),
-        (Some(a), None) => without(model, gains, x, nbrs, leader, a, &Ideal),
-        (Some(a), Some(b)) => without(model, gains, x, nbrs, leader, a, b),
+        (None, None) => agent_field(model, gains, x, nbrs, leader, (&Ideal, ext)),
+        (None, Some(b)) => agent_field(model, gains, x, nbrs, leader, (b, ext)),
+        (Some(a), None) => without(model, gains, x, nbrs, leader, a, (&Ideal, ext)),
+        (Some(a), Some(b)) => without(model, gains, x, nbrs, leader, a, (b, ext)),
     }
 }
 
-/// The inputs left out now (when any is) and the state of the body's
-/// random effects, from an agent's timeline box.
-fn split(timed: Option<&mut Timed>) -> (Option<&mut Absent>, Option<&EffectsState>) {
+/// The inputs left out now (when any is), the state of the body's random
+/// effects and a law given from outside, from an agent's timeline box.
+fn split(
+    timed: Option<&mut Timed>,
+) -> (Option<&mut Absent>, Option<&EffectsState>, Option<&dyn Law>) {
     match timed {
-        Some(t) => (t.absent.as_mut().filter(|a| a.any), t.effects.as_ref()),
-        None => (None, None),
+        Some(t) => (
+            t.absent.as_mut().filter(|a| a.any),
+            t.effects.as_ref(),
+            t.law.as_deref(),
+        ),
+        None => (None, None, None),
     }
 }
 
@@ -261,6 +322,8 @@ struct Timed {
     down: Option<Down>,
     /// The state at t = 0, for a restart from it.
     initial: AgentState,
+    /// A control law given from outside, in place of the scheme's.
+    law: Option<SharedLaw>,
 }
 
 /// An agent that is down: the stage it is at, and how it comes back.
@@ -312,6 +375,7 @@ impl Agent {
                 effects,
                 down: None,
                 initial,
+                law: None,
             })
         });
         let mut agent = Self {
@@ -421,6 +485,23 @@ impl Agent {
         }
         self.tau0 = Vector3::zeros();
         self.verdicts = Verdicts::default();
+    }
+
+    /// The agent with `law` in place of its scheme's torque ([`crate::law`]).
+    #[must_use]
+    pub fn with_law(mut self, law: SharedLaw) -> Self {
+        let timed = self.timed.get_or_insert_with(|| {
+            Box::new(Timed {
+                retuned: Due::default(),
+                absent: None,
+                effects: None,
+                down: None,
+                initial: self.state,
+                law: None,
+            })
+        });
+        timed.law = Some(law);
+        self
     }
 
     /// Whether the agent is down (crashed) at the current step.
@@ -685,11 +766,22 @@ impl Agent {
         }
         self.update_links();
         let leader = self.held_leader.as_deref();
-        let (absent, state) = split(self.timed.as_deref_mut());
+        let (absent, state, law) = split(self.timed.as_deref_mut());
         let slot = (self.n, self.step.stage());
         let at = at(&self.model, state, slot, self.step.h(), self.tau0);
+        let ext = law.map(|law| External {
+            law,
+            step: slot.0,
+            stage: slot.1,
+            dt: self.step.h(),
+        });
         let own = (&self.model, &self.gains[..], &self.stage_x);
-        let (d, tau) = field(own, &self.held_nbrs, leader, absent, at.as_ref());
+        let (d, tau) = field(
+            own,
+            &self.held_nbrs,
+            leader,
+            (absent, at.as_ref(), ext.as_ref()),
+        );
         self.finish_stage(&d, &tau)
     }
 
@@ -712,11 +804,17 @@ impl Agent {
             }
         }
         let leader = self.held_leader.as_deref();
-        let (absent, state) = split(self.timed.as_deref_mut());
+        let (absent, state, law) = split(self.timed.as_deref_mut());
         let slot = (self.n, self.step.stage());
         let at = at(&self.model, state, slot, self.step.h(), self.tau0);
+        let ext = law.map(|law| External {
+            law,
+            step: slot.0,
+            stage: slot.1,
+            dt: self.step.h(),
+        });
         let own = (&self.model, &self.gains[..], &self.stage_x);
-        let (d, tau) = field(own, nbrs, leader, absent, at.as_ref());
+        let (d, tau) = field(own, nbrs, leader, (absent, at.as_ref(), ext.as_ref()));
         self.finish_stage(&d, &tau)
     }
 

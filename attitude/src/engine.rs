@@ -127,6 +127,18 @@ impl InProcess {
         }
     }
 
+    /// Every agent with `law` in place of its scheme's torque
+    /// ([`crate::law`]), run on the calling thread only (a law from
+    /// outside may not be callable from several at once).
+    #[must_use]
+    pub fn with_law(mut self, law: crate::law::SharedLaw) -> Self {
+        self.agents = (std::mem::take(&mut self.agents).into_iter())
+            .map(|a| a.with_law(law.clone()))
+            .collect();
+        self.threads = 1;
+        self
+    }
+
     /// Runs on up to `threads` threads, each with at least
     /// [`MIN_AGENTS_PER_THREAD`] agents (so a small network stays on one).
     #[must_use]

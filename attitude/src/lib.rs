@@ -46,6 +46,7 @@ pub mod effects;
 pub mod engine;
 pub mod guard;
 pub mod integrate;
+pub mod law;
 pub mod linear;
 pub mod link;
 pub mod metrics;

@@ -95,6 +95,7 @@ pub(crate) fn options(out: PathBuf, until: Until) -> RunOptions {
             tolerance: 1e-3,
             until,
         },
+        law: None,
     }
 }
 

@@ -64,6 +64,9 @@ pub struct RunOptions {
     pub hosts: Option<Hosts>,
     /// `--tolerance` and `--until`: what the run is judged by and how long it goes.
     pub judging: Judging,
+    /// A control law from outside in place of the scheme's (the Python
+    /// package's `law=`; [`attitude::law`]): in-process, on one thread.
+    pub law: Option<attitude::law::SharedLaw>,
 }
 
 /// The default `--threads`: the number of cores (1 if unknown).
@@ -357,6 +360,9 @@ fn drive_in_process(
     let mut rec = Recording::start(loaded, opts, layout, bar)?;
     let row = rec.recorder.row_maker();
     let mut engine = InProcess::new(net).with_threads(opts.threads);
+    if let Some(law) = &opts.law {
+        engine = engine.with_law(law.clone());
+    }
     let max = opts.judging.max_steps(net.steps, net.dt);
     let (mut chunks, mut interrupted) = (0, false);
     let (diverged, verdict) = loop {
@@ -692,6 +698,11 @@ fn check_options(loaded: &Loaded, opts: &RunOptions) -> Result<(), OptionError> 
     let plugins = &loaded.resolved.plugins;
     let crashes = (loaded.resolved.network.agents.iter())
         .any(|a| (a.model.timeline.as_deref()).is_some_and(|t| !t.crashes.is_empty()));
+    if opts.law.is_some() && opts.engine != Engine::InProcess {
+        return Err(OptionError::Conflict(
+            "a control law given from outside (law=) runs in-process only".into(),
+        ));
+    }
     if crashes && (opts.processes.realtime.is_some() || opts.hosts.is_some()) {
         return Err(OptionError::Conflict(
             "a crash ([[event]] action = \"crash\") cannot run with --realtime or --hosts: \
@@ -766,6 +777,7 @@ mod tests {
             view: false,
             hosts: None,
             judging: Judging::default(),
+            law: None,
         }
     }
 

@@ -39,6 +39,7 @@ fn options(out: &Path, until: Until) -> RunOptions {
             tolerance: 1e-3,
             until,
         },
+        law: None,
     }
 }
 

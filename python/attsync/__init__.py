@@ -27,6 +27,9 @@ from . import _attsync
 from .states import States, StatesFormatError, read_states
 
 __all__ = [
+    "Heard",
+    "LawContext",
+    "LawError",
     "Run",
     "RunError",
     "Scenario",
@@ -46,6 +49,66 @@ __version__ = _attsync.__version__
 
 #: A run that could not start or did not complete (``exit_code`` as the CLI's).
 RunError = _attsync.RunError
+
+#: A control law given with ``law=`` raised, or returned something other than
+#: 3 finite numbers; the message names the agent, the step, the stage and the cause.
+LawError = _attsync.LawError
+
+import numpy as np  # noqa: E402
+
+
+class Heard:
+    """What an agent holds of one input: its gain ``a`` (3×3) and the value
+    received, ``R``, ``omega``, ``sigma`` (the sender's ``(R̂, ω̂, σ̂)`` for the
+    observer schemes, ``(R, ω, 0)`` for the observerless one)."""
+
+    __slots__ = ("a", "R", "omega", "sigma")
+
+
+class LawContext:
+    """What a control law receives at one stage of one agent: what the
+    built-in law receives (docs/python.md, "Your own law").
+
+    ``agent``, ``step``, ``stage`` (0–3), ``t`` (the stage's time, s), ``dt``;
+    the agent's measured ``R`` (3×3), ``omega``, and its observer's ``R_hat``,
+    ``omega_hat``, ``sigma_hat``, ``omega_hat_dot``; ``neighbours`` (a list of
+    :class:`Heard`, in id order), ``leader`` (a :class:`Heard`, or None when
+    the agent does not hear it); the scheme's gains ``k_r``, ``k_omega``; the
+    ``inertia`` the law assumes (3×3). The arrays are views of one array
+    made for the call: copy what you keep."""
+
+    __slots__ = ("agent", "step", "stage", "t", "dt", "R", "omega", "R_hat", "omega_hat",
+                 "sigma_hat", "omega_hat_dot", "neighbours", "leader", "k_r", "k_omega", "inertia")
+
+
+def _heard(v, o):
+    h = Heard()
+    h.a, h.R = v[o : o + 9].reshape(3, 3), v[o + 9 : o + 18].reshape(3, 3)
+    h.omega, h.sigma = v[o + 18 : o + 21], v[o + 21 : o + 24]
+    return h
+
+
+def _adapter(f):
+    """``f(ctx) -> torque`` as the native module calls a law: one flat tuple
+    of numbers in (python/src/law.rs says its order), 3 floats out."""
+
+    def call(when, data, n_nbrs, has_leader, k):
+        c = LawContext()
+        c.agent, c.step, c.stage, c.t, c.dt = when
+        v = np.array(data)
+        c.R, c.omega = v[0:9].reshape(3, 3), v[9:12]
+        c.R_hat, c.omega_hat, c.sigma_hat = v[12:21].reshape(3, 3), v[21:24], v[24:27]
+        c.omega_hat_dot, c.inertia = v[27:30], v[30:39].reshape(3, 3)
+        heard = [_heard(v, o) for o in range(39, 39 + 24 * (n_nbrs + has_leader), 24)]
+        c.leader = heard.pop(0) if has_leader else None
+        c.neighbours = heard
+        c.k_r, c.k_omega = k
+        tau = np.asarray(f(c), dtype=float)
+        if tau.shape != (3,):
+            raise ValueError(f"the law returned an array of shape {tau.shape}, not (3,)")
+        return (float(tau[0]), float(tau[1]), float(tau[2]))
+
+    return call
 
 
 class ScenarioError(ValueError):
@@ -192,7 +255,7 @@ class Run:
         return f"<attsync.Run {s.get('scenario')} ({s.get('engine')}, t = {s.get('t_end')} s): {self.dir}>"
 
 
-def run(scenario, engine: str = "in-process", threads: Optional[int] = None, out=None) -> Run:
+def run(scenario, engine: str = "in-process", threads: Optional[int] = None, out=None, law=None) -> Run:
     """Runs ``scenario`` (a :class:`Scenario` or a path) as ``attsync run``
     does, on ``engine`` (``"in-process"`` or ``"processes"``).
 
@@ -203,6 +266,14 @@ def run(scenario, engine: str = "in-process", threads: Optional[int] = None, out
     ``Run.complete`` is false and ``Run.summary["incomplete_reason"]`` says
     why (Ctrl-C then raises ``KeyboardInterrupt``); a run that cannot start
     raises :class:`RunError`.
+
+    ``law``: a function ``f(ctx) -> torque`` (3 numbers, N·m, body frame)
+    called for each agent at each stage with a :class:`LawContext`, in place
+    of the scheme's law (the observers stay the model's; the actuator's
+    limits still apply). In-process, on one thread, deterministic. A law
+    that raises or returns anything but 3 finite numbers stops the run at
+    that step and raises :class:`LawError` naming the agent, the step and the
+    cause (the results so far are kept, as a diverged run's).
     """
     if not isinstance(scenario, Scenario):
         scenario = load(scenario)
@@ -210,7 +281,8 @@ def run(scenario, engine: str = "in-process", threads: Optional[int] = None, out
     if out is None:
         keep = tempfile.TemporaryDirectory(prefix="attsync-")
         out = Path(keep.name) / "results"
-    _native(_attsync.run, str(scenario.path), scenario.sets, Path(out), engine, threads)
+    adapter = None if law is None else _adapter(law)
+    _native(_attsync.run, str(scenario.path), scenario.sets, Path(out), engine, threads, adapter)
     return Run(out, _keep=keep)
 
 
@@ -256,11 +328,14 @@ def sweep(scenario, param: str, values, engine: str = "in-process", out=None, gr
 
 
 def mc(scenario, trials: int, seed: int = 0, engine: str = "in-process", out=None,
-       jobs: Optional[int] = None) -> pd.DataFrame:
+       jobs: Optional[int] = None, law=None) -> pd.DataFrame:
     """``attsync mc``: ``trials`` runs with initial conditions (and the
     scenario's ``[[monte_carlo.param]]`` fields) drawn from ``seed``; the
-    rows of ``trials.csv`` (one per trial: its draws, verdict, settle time)."""
-    return _table(_attsync.mc, scenario, out, "trials.csv", int(trials), int(seed), engine=engine, jobs=jobs)
+    rows of ``trials.csv`` (one per trial: its draws, verdict, settle time).
+    ``law`` as for :func:`run`."""
+    adapter = None if law is None else _adapter(law)
+    return _table(_attsync.mc, scenario, out, "trials.csv", int(trials), int(seed), engine=engine, jobs=jobs,
+                  law=adapter)
 
 
 def margin(scenario) -> dict:

@@ -168,7 +168,7 @@ fn one(
 ) -> Result<Ran, McError> {
     let p = base.prepare(k)?;
     match o.engine {
-        Engine::InProcess => Ok(run_in_process(&p, &o.judging, interrupt)),
+        Engine::InProcess => Ok(run_in_process(&p, (&o.judging, o.law.as_ref()), interrupt)),
         Engine::Processes => {
             let logs = layout::McLayout::new(dir).trial_logs(k);
             let ran = run_processes(&p, &o.processes, &logs, &o.judging, interrupt)
@@ -283,6 +283,7 @@ pub fn trial_alone(
         view: true,
         hosts: None,
         judging: o.judging,
+        law: o.law.clone(),
     };
     let summary = crate::run::run(&prepared.loaded, &opts, interrupt)?;
     if let Some(signal) = interrupt.signal() {

@@ -36,6 +36,9 @@ pub struct McOptions {
     pub progress: bool,
     /// `--no-stiffness-check`.
     pub stiffness: StiffnessCheck,
+    /// A control law from outside in place of the scheme's (in-process only;
+    /// [`attitude::law`]).
+    pub law: Option<attitude::law::SharedLaw>,
 }
 
 impl McOptions {

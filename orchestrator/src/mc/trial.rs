@@ -123,14 +123,21 @@ fn has_observer(p: &Prepared) -> bool {
         .is_some_and(|a| a.model.scheme.has_observer())
 }
 
-/// Runs trial `p` in-process on the calling thread, keeping only its
-/// trace; with `--until settled` its horizon is extended until the verdict
-/// is final ([`crate::until`]).
+/// Runs trial `p` in-process on the calling thread (with `law` in place of
+/// the scheme's, if given), keeping only its trace; with `--until settled`
+/// its horizon is extended until the verdict is final ([`crate::until`]).
 #[must_use]
-pub fn run_in_process(p: &Prepared, judging: &Judging, interrupt: &Interrupt) -> Ran {
+pub fn run_in_process(
+    p: &Prepared,
+    (judging, law): (&Judging, Option<&attitude::law::SharedLaw>),
+    interrupt: &Interrupt,
+) -> Ran {
     let net = &p.loaded.resolved.network;
     let mut trace = Trace::new(net, has_observer(p));
     let mut engine = InProcess::new(net);
+    if let Some(law) = law {
+        engine = engine.with_law(law.clone());
+    }
     let max = judging.max_steps(net.steps, net.dt);
     let mut stopped = false;
     let diverged = loop {

@@ -630,6 +630,7 @@ mod tests {
                 view: false,
                 hosts: None,
                 judging: crate::run::Judging::default(),
+                law: None,
             },
             find_margin: Some(Bisection {
                 iterations: 8,

@@ -197,6 +197,7 @@ fn options(
         // A run `--until settled` extended recorded its final horizon in
         // its scenario.toml: the re-run goes exactly that far.
         judging: run::Judging::default(),
+        law: None,
     })
 }
 

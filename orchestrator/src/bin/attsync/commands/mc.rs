@@ -89,6 +89,7 @@ pub fn exec(a: Mc, interrupt: &Interrupt) -> Result<(), Error> {
         out: (a.out.clone()).unwrap_or_else(|| mc::options::default_out(&loaded.name())),
         progress: !a.quiet && std::io::stderr().is_terminal(),
         stiffness: check,
+        law: None,
     };
     match a.trial {
         Some(k) => alone(&o, k, a.out.is_none().then(|| loaded.name()), interrupt),

@@ -66,6 +66,7 @@ pub fn exec(a: Run, interrupt: &Interrupt) -> Result<(), Error> {
         view: !a.no_view,
         hosts,
         judging: a.until.judging(a.tolerance, 1.0, false),
+        law: None,
     };
     opts.validate()?;
     let loaded = a

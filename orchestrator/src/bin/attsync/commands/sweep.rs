@@ -82,6 +82,7 @@ pub fn exec(a: Sweep, interrupt: &Interrupt) -> Result<(), Error> {
             view: false,
             hosts,
             judging: a.until.judging(a.tolerance, 1.0, a.find_margin),
+            law: None,
         },
         find_margin: a.find_margin.then_some(Bisection {
             iterations: a.bisect,
