@@ -194,3 +194,24 @@ def test_margin_is_the_clis(tmp_path):
     theirs = json.loads((tmp_path / "m.json").read_text())
     assert m["margin"] == theirs["margin"]
     assert m["kind"] == "crossing" and abs(m["margin"] - 0.389) < 1e-3
+
+
+def test_parquet_reads_back_exactly(tmp_path):
+    r = attsync.run(short(duration=1), out=tmp_path / "r")
+    d = r.to_parquet(tmp_path / "pq")
+    errors = pd.read_parquet(d / "errors.parquet")
+    pd.testing.assert_frame_equal(errors, r.errors)
+    states = pd.read_parquet(d / "states.parquet")
+    s = r.states
+    assert len(states) == s.R.shape[0] * s.R.shape[1]
+    row = states.iloc[37 * 7 + 2]
+    assert row["agent"] == s.agent_ids[2] and row["t"] == s.t[37]
+    assert row["r23"] == s.R[37, 2, 1, 2] and row["w_hat3"] == s.omega_hat[37, 2, 2]
+    assert row["tau1"] == s.tau[37, 2, 0]
+    leader = pd.read_parquet(d / "leader.parquet")
+    assert np.array_equal(leader[["r11", "r12", "r13"]].to_numpy(), s.R0[:, 0, :])
+    # The agents' columns are export --csv's.
+    o = cli("export", r.dir / "states.bin", "--csv")
+    header = o.stdout.splitlines()[0].split(",")
+    assert list(states.columns) == ["t", "agent"] + header[2:]
+    assert sorted(p.name for p in d.iterdir()) == ["errors.parquet", "leader.parquet", "states.parquet"]
