@@ -374,3 +374,61 @@ fn the_manifest_lists_every_file_with_its_sha256() {
         "{started}"
     );
 }
+
+#[test]
+fn a_sweep_or_monte_carlo_directory_says_what_to_verify_instead() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = tmp.path().join("sweep");
+    let args: Vec<String> = [
+        "sweep",
+        PAPER,
+        "--param",
+        "network.delay",
+        "--values",
+        "0,0.01",
+        "--set",
+        "simulation.duration=0.2",
+        "--out",
+    ]
+    .iter()
+    .map(|s| (*s).to_string())
+    .chain([sweep.display().to_string()])
+    .collect();
+    attsync(tmp.path(), &args).assert_code(0);
+    let o = verify(tmp.path(), &sweep, &[]);
+    o.assert_code(2);
+    assert!(o.stderr.contains("a sweep's directory"), "{}", o.stderr);
+    let example = sweep.join("runs").join("000-0");
+    assert!(
+        o.stderr
+            .contains(&format!("attsync verify {}", example.display())),
+        "{}",
+        o.stderr
+    );
+    // What it suggests verifies.
+    verify(tmp.path(), &example, &[]).assert_code(0);
+
+    let mc = tmp.path().join("mc");
+    let args: Vec<String> = [
+        "mc",
+        PAPER,
+        "--trials",
+        "2",
+        "--set",
+        "simulation.duration=0.2",
+        "--out",
+    ]
+    .iter()
+    .map(|s| (*s).to_string())
+    .chain([mc.display().to_string()])
+    .collect();
+    attsync(tmp.path(), &args).assert_code(0);
+    let o = verify(tmp.path(), &mc, &[]);
+    o.assert_code(2);
+    assert!(
+        o.stderr.contains("a Monte Carlo's directory"),
+        "{}",
+        o.stderr
+    );
+    assert!(o.stderr.contains("--trial K"), "{}", o.stderr);
+}

@@ -456,12 +456,7 @@ pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), CsvError> {
     let (h, records) = read(file)?;
     let io = CsvError::Write;
     writeln!(out, "{}", csv_columns().join(",")).map_err(io)?;
-    let join = |v: &[f64]| {
-        v.iter()
-            .map(|x| x.to_string())
-            .collect::<Vec<_>>()
-            .join(",")
-    };
+    let join = |v: &[f64]| v.iter().map(|&x| shortest(x)).collect::<Vec<_>>().join(",");
     for rec in &records {
         let t = super::fmt_time(rec.step, h.dt);
         writeln!(
@@ -490,6 +485,16 @@ pub fn export_csv(file: &Path, out: &mut dyn Write) -> Result<(), CsvError> {
         }
     }
     Ok(())
+}
+
+/// `x` in the shorter of its two shortest round-trip forms, plain
+/// (`0.25`, `-3`) or exponent (`1.5e-79`, `2.5e21`): either reads back as
+/// exactly `x`; plain wins a tie.
+#[must_use]
+pub fn shortest(x: f64) -> String {
+    let plain = x.to_string();
+    let exp = format!("{x:e}");
+    if exp.len() < plain.len() { exp } else { plain }
 }
 
 /// Why a `states.bin` cannot be read.
@@ -554,6 +559,22 @@ pub enum CsvError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_are_written_short_and_read_back_exactly() {
+        for (x, text) in [
+            (1.5e-79, "1.5e-79"),
+            (0.25, "0.25"),
+            (-3.0, "-3"),
+            (2.5e21, "2.5e21"),
+            (0.1 + 0.2, "0.30000000000000004"),
+            (f64::NAN, "NaN"),
+        ] {
+            assert_eq!(shortest(x), text);
+            let back: f64 = shortest(x).parse().unwrap();
+            assert!(back == x || (x.is_nan() && back.is_nan()));
+        }
+    }
 
     #[test]
     fn a_full_disk_while_encoding_is_said_as_the_os_error() {

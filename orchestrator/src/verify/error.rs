@@ -13,6 +13,17 @@ pub enum VerifyError {
     /// `manifest.json` is missing, unreadable, not a manifest or of another version (exit 2).
     #[error(transparent)]
     Manifest(#[from] ManifestError),
+    /// The directory holds a sweep's or a Monte Carlo's results, not one
+    /// run's (exit 2): what to verify instead.
+    #[error("{}: {what}, not one run's results; {instead}", dir.display())]
+    NotARun {
+        /// The directory.
+        dir: PathBuf,
+        /// What it holds.
+        what: &'static str,
+        /// What to verify instead.
+        instead: String,
+    },
     /// A recorded setting this attsync does not know (exit 2).
     #[error("{}: {field} {value:?} is not one of {expected}", manifest.display())]
     Setting {
@@ -103,6 +114,7 @@ impl VerifyError {
     pub fn exit_code(&self) -> u8 {
         match self {
             Self::Manifest(_)
+            | Self::NotARun { .. }
             | Self::Setting { .. }
             | Self::ScenarioFile { .. }
             | Self::ScenarioHash { .. }

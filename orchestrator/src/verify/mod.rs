@@ -60,6 +60,47 @@ pub struct VerifyOptions {
     pub progress: bool,
 }
 
+/// Refuses, saying what to verify instead, a directory without
+/// `manifest.json` that holds a sweep's or a Monte Carlo's results.
+fn not_a_sweep_or_mc(dir: &Path, layout: &RunLayout) -> Result<(), VerifyError> {
+    use crate::results::layout::{MC_JSON, RUNS, SWEEP_CSV};
+    if layout.manifest().exists() {
+        return Ok(());
+    }
+    let not = |what, instead: String| {
+        Err(VerifyError::NotARun {
+            dir: dir.to_owned(),
+            what,
+            instead,
+        })
+    };
+    if dir.join(SWEEP_CSV).is_file() {
+        let first = std::fs::read_dir(dir.join(RUNS))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .map(|e| e.path())
+            .min();
+        let example = first.map_or_else(
+            || format!("{}/{RUNS}/<run>", dir.display()),
+            |p| p.display().to_string(),
+        );
+        return not(
+            "a sweep's directory",
+            format!("verify each of its runs, e.g. `attsync verify {example}`"),
+        );
+    }
+    if dir.join(MC_JSON).is_file() {
+        return not(
+            "a Monte Carlo's directory",
+            "its trials keep no results of their own: run one with `attsync mc SCENARIO --seed S \
+             --trial K --out DIR` (mc.json has the seed) and verify that DIR"
+                .into(),
+        );
+    }
+    Ok(())
+}
+
 /// Verifies the run in `dir`: its files against `manifest.json`, and a
 /// re-run of its scenario against its `states.bin` and `errors.csv`.
 ///
@@ -72,6 +113,7 @@ pub fn verify(
     interrupt: &Interrupt,
 ) -> Result<Report, VerifyError> {
     let layout = RunLayout::new(dir);
+    not_a_sweep_or_mc(dir, &layout)?;
     let manifest = Manifest::read(&layout)?;
     refuse(dir, &manifest)?;
     let text = scenario_text(&layout, &manifest)?;
