@@ -14,6 +14,20 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use std::sync::Mutex;
 
+/// Why a call of the law gave no torque.
+#[derive(Debug, thiserror::Error)]
+enum Failed {
+    /// The law (or the adapter) raised: the Python exception, as text.
+    #[error("{0}")]
+    Raised(String),
+    /// It returned something that is not 3 numbers.
+    #[error("the law's torque is not 3 numbers: {0}")]
+    NotThree(String),
+    /// It returned a NaN or an infinity.
+    #[error("the law returned a torque that is not finite: [{}, {}, {}]", .0[0], .0[1], .0[2])]
+    NotFinite([f64; 3]),
+}
+
 /// A Python control law.
 #[derive(Debug)]
 pub struct PyLaw {
@@ -40,7 +54,7 @@ impl PyLaw {
     /// one flat tuple (one numpy array on the other side, viewed in parts):
     /// the state (27), `ω̂̇` (3), the inertia (9), the leader's gain and
     /// value if heard (24), each neighbour's (24).
-    fn call(&self, py: Python<'_>, i: &LawInput<'_>) -> Result<Vector3<f64>, String> {
+    fn call(&self, py: Python<'_>, i: &LawInput<'_>) -> Result<Vector3<f64>, Failed> {
         let s = i.state;
         let mut data: Vec<f64> = Vec::with_capacity(39 + 24 * (i.gains.len() + 1));
         data.extend(rows(&s.r));
@@ -61,22 +75,19 @@ impl PyLaw {
         }
         let args = (
             (i.agent, i.step, i.stage, i.t, i.dt),
-            PyTuple::new(py, data).map_err(|e| e.to_string())?,
+            PyTuple::new(py, data).map_err(|e| Failed::Raised(e.to_string()))?,
             i.gains.len(),
             i.leader.is_some(),
             i.k,
         );
-        let out = self.adapter.call1(py, args).map_err(|e| e.to_string())?;
+        let out = (self.adapter.call1(py, args)).map_err(|e| Failed::Raised(e.to_string()))?;
         let (a, b, c): (f64, f64, f64) = out
             .extract(py)
-            .map_err(|e| format!("the law's torque is not 3 numbers: {e}"))?;
-        let tau = Vector3::new(a, b, c);
-        if !tau.iter().all(|v| v.is_finite()) {
-            return Err(format!(
-                "the law returned a torque that is not finite: [{a}, {b}, {c}]"
-            ));
+            .map_err(|e| Failed::NotThree(e.to_string()))?;
+        if ![a, b, c].iter().all(|v| v.is_finite()) {
+            return Err(Failed::NotFinite([a, b, c]));
         }
-        Ok(tau)
+        Ok(Vector3::new(a, b, c))
     }
 }
 
