@@ -80,7 +80,7 @@ pub use namespace::{
     started_by,
 };
 pub use netns::{Veth, link_exists};
-pub use python::{conform_python, require_iceoryx2_module};
+pub use python::{conform_python, require_iceoryx2_module, require_python_modules};
 pub use results::{
     assert_same_bytes, assert_same_file, assert_same_results, csv_agents, csv_rows, read,
     staging_dir, summary, summary_without,

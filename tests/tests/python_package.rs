@@ -4,25 +4,11 @@
 //! package directory of the test's own with the Python sources beside it.
 //! `pip install ./python` builds the same module with maturin (README).
 
-use attsync_tests::Sandbox;
 use attsync_tests::bin_dir;
+use attsync_tests::{Sandbox, require_python_modules};
 use std::fs;
 use std::path::Path;
 use std::process::Command;
-
-/// Panics, saying how to install them, unless `python3` has the package's
-/// dependencies and pytest (`python/requirements.txt`).
-fn require_modules() {
-    let ok = Command::new("python3")
-        .args(["-c", "import numpy, pandas, pyarrow, pytest"])
-        .status()
-        .is_ok_and(|s| s.success());
-    assert!(
-        ok,
-        "python3 cannot import numpy, pandas, pyarrow and pytest: run tools/test-deps.sh \
-         (or `python3 -m pip install -r python/requirements.txt`)"
-    );
-}
 
 /// `dir/attsync/`: the package's Python sources and the built native module.
 fn assemble(dir: &Path) {
@@ -46,7 +32,10 @@ fn assemble(dir: &Path) {
 
 #[test]
 fn the_python_packages_tests_pass() {
-    require_modules();
+    require_python_modules(
+        "numpy, pandas, pyarrow, pytest",
+        "tools/test-deps.sh (or `python3 -m pip install -r python/requirements.txt`)",
+    );
     let tmp = Sandbox::new("python_package");
     assemble(tmp.path());
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -182,20 +182,12 @@ pub fn run_with<S: Service, N: Stepper, H: Hooks>(
     shutdown: &AtomicBool,
 ) -> Result<(), NodeError> {
     let orphan = Orphan::new()?;
-    let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
     let ports = Ports::open(node, cfg)?;
     ports.await_connections(cfg, &orphan)?;
     let mut io = Hooked::new(&ports, hooks, cfg.id);
     io.report(Telemetry::Ready)?;
     info!(id = cfg.id, inputs = ?cfg.inputs, outputs = ?cfg.outputs, "ready");
-    let start = match &cfg.resume {
-        // A new process of a crashed agent joins a run under way.
-        Some(_) => unix_ns_now(),
-        None => match wait_command(&mut io, start_timeout, shutdown, &orphan)? {
-            Some((ControlCommand::Start, start)) => start,
-            _ => return Err(NodeError::Stopped(0)),
-        },
-    };
+    let start = await_start(&mut io, cfg, shutdown, &orphan)?;
     info!(realtime = ?cfg.realtime, "started");
     let started_unix_ns = unix_ns_now();
 
@@ -242,10 +234,37 @@ pub fn run_with<S: Service, N: Stepper, H: Hooks>(
     };
     io.report(Telemetry::Done(done))?;
     info!(steps = cfg.steps, peak_rss_kb = done.peak_rss_kb, "done");
-    // Other nodes may still be stepping: wait for Stop as long as the
-    // orchestrator lives (bounded by STOP_TIMEOUT all the same).
+    await_stop(&mut io, cfg, shutdown, &orphan)
+}
+
+/// Waits (bounded by the start timeout) for `Start`: its `start_unix_ns`.
+/// A new process of a crashed agent joins a run under way: it starts at once.
+fn await_start<S: Service, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
+    cfg: &NodeConfig,
+    shutdown: &AtomicBool,
+    orphan: &Orphan,
+) -> Result<u64, NodeError> {
+    if cfg.resume.is_some() {
+        return Ok(unix_ns_now());
+    }
+    let start_timeout = Duration::from_secs_f64(cfg.start_timeout);
+    match wait_command(io, start_timeout, shutdown, orphan)? {
+        Some((ControlCommand::Start, start)) => Ok(start),
+        _ => Err(NodeError::Stopped(0)),
+    }
+}
+
+/// After `Done`: other nodes may still be stepping, so waits for `Stop` as
+/// long as the orchestrator lives (bounded by [`STOP_TIMEOUT`] all the same).
+fn await_stop<S: Service, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
+    cfg: &NodeConfig,
+    shutdown: &AtomicBool,
+    orphan: &Orphan,
+) -> Result<(), NodeError> {
     loop {
-        match wait_command(&mut io, STOP_TIMEOUT, shutdown, &orphan)? {
+        match wait_command(io, STOP_TIMEOUT, shutdown, orphan)? {
             Some((ControlCommand::Stop, _)) | None => return Ok(()),
             // A process that joined the run late reads the run's Start now.
             Some((ControlCommand::Start, _)) if cfg.resume.is_some() => {}
