@@ -535,6 +535,7 @@ fn summarise(
     Summary {
         attsync_version: env!("CARGO_PKG_VERSION").into(),
         scenario: loaded.name(),
+        overrides: loaded.document.sets().to_vec(),
         engine: opts.engine.name().into(),
         law: loaded.scenario.scheme.law,
         complete: outcome.failure.is_none() && outcome.diverged.is_none() && steps == horizon,
@@ -583,7 +584,7 @@ fn write_results(
     (series, torque_plot): (&[Series], bool),
 ) -> Result<(), RunError> {
     let svg = layout.errors_svg();
-    let title = format!("{} ({})", summary.scenario, summary.engine);
+    let title = plot::title(summary);
     // Real-time runs measure every link's age of information; lockstep
     // links are ideal (or impaired by design, which summary.json lists).
     let aoi = if summary.realtime.is_some() {

@@ -12,7 +12,7 @@ use common::{OBSERVERLESS, PAPER, attsync, run_args};
 use std::fs;
 use std::path::Path;
 
-const OBSERVER_CAPTION: &str = "observer attitude error";
+const OBSERVER_CAPTION: &str = "attitude error of the observer";
 
 /// `attsync run SCENARIO --engine in-process --out OUT --quiet EXTRA…`,
 /// which must succeed.

@@ -39,6 +39,7 @@ __all__ = [
     "load",
     "margin",
     "mc",
+    "mc_merge",
     "open",
     "read_states",
     "run",
@@ -53,6 +54,11 @@ RunError = _attsync.RunError
 #: A control law given with ``law=`` raised, or returned something other than
 #: 3 finite numbers; the message names the agent, the step, the stage and the cause.
 LawError = _attsync.LawError
+
+# Pickled by reference as attsync.RunError and attsync.LawError (a trial that
+# fails on a Dask worker raises the same exception in the client).
+for _e in (RunError, LawError):
+    _e.__module__ = "attsync"
 
 import numpy as np  # noqa: E402
 
@@ -124,6 +130,9 @@ class ScenarioError(ValueError):
         self.file = file
         self.issues = [tuple(i) for i in issues]
         self.field, self.reason = self.issues[0] if self.issues else ("", message)
+
+    def __reduce__(self):
+        return (ScenarioError, (str(self), self.file, self.issues))
 
 
 def _native(f, *args, **kwargs):
@@ -292,6 +301,21 @@ class Run:
             tmp.replace(d / f"{name}.parquet")
         return d
 
+    def plot(self, path=None, observer: Optional[bool] = None, title: Optional[str] = None):
+        """The paper's figure of this run (matplotlib, optional): the errors
+        against time on log axes in the paper's symbols (|R̃ᵢ|_I, ‖ωᵢ − ω₀‖),
+        the observer's where the scheme has one, each agent in the look
+        ``errors.svg`` and the 3D view give it (colour-blind-safe colour and
+        dash), the ``--set`` changes in the title. With ``path`` it is also
+        written there (``.pdf``, ``.svg``, ``.png``). Returns the
+        ``matplotlib.figure.Figure``."""
+        from . import plot as _plot
+
+        fig = _plot.figure(self.errors, self.summary, observer=observer, title=title)
+        if path is not None:
+            _plot.save(fig, path)
+        return fig
+
     @property
     def complete(self) -> bool:
         """Whether the run reached its horizon (``summary["complete"]``)."""
@@ -343,16 +367,16 @@ def _scenario(scenario) -> Scenario:
     return scenario if isinstance(scenario, Scenario) else load(scenario)
 
 
-def _table(native, scenario, out, csv_name, *args, **kwargs) -> pd.DataFrame:
-    """Runs ``native`` into ``out`` (a temporary directory if None) and reads
-    its ``csv_name``; the directory is in ``DataFrame.attrs["dir"]`` when kept."""
-    sc = _scenario(scenario)
+def _rows(out, csv_name: str, write) -> pd.DataFrame:
+    """Calls ``write(directory)`` with ``out`` (a temporary directory if
+    None) and reads its ``csv_name``; the directory is in
+    ``DataFrame.attrs["dir"]`` when kept."""
     keep = None
     if out is None:
         keep = tempfile.TemporaryDirectory(prefix="attsync-")
         out = Path(keep.name) / "results"
     try:
-        _native(native, str(sc.path), sc.sets, *args, Path(out), **kwargs)
+        write(Path(out))
         df = pd.read_csv(Path(out) / csv_name, float_precision="round_trip")
     finally:
         if keep is not None:
@@ -360,6 +384,12 @@ def _table(native, scenario, out, csv_name, *args, **kwargs) -> pd.DataFrame:
     if keep is None:
         df.attrs["dir"] = str(out)
     return df
+
+
+def _table(native, scenario, out, csv_name, *args, **kwargs) -> pd.DataFrame:
+    """Runs ``native`` into ``out`` and reads its ``csv_name`` (:func:`_rows`)."""
+    sc = _scenario(scenario)
+    return _rows(out, csv_name, lambda o: _native(native, str(sc.path), sc.sets, *args, o, **kwargs))
 
 
 def sweep(scenario, param: str, values, engine: str = "in-process", out=None, grid=None,
@@ -375,14 +405,89 @@ def sweep(scenario, param: str, values, engine: str = "in-process", out=None, gr
 
 
 def mc(scenario, trials: int, seed: int = 0, engine: str = "in-process", out=None,
-       jobs: Optional[int] = None, law=None) -> pd.DataFrame:
+       jobs: Optional[int] = None, law=None, client=None, shards: Optional[int] = None) -> pd.DataFrame:
     """``attsync mc``: ``trials`` runs with initial conditions (and the
     scenario's ``[[monte_carlo.param]]`` fields) drawn from ``seed``; the
     rows of ``trials.csv`` (one per trial: its draws, verdict, settle time).
-    ``law`` as for :func:`run`."""
+    ``law`` as for :func:`run`.
+
+    ``client``: a ``dask.distributed.Client``: the trials run on its
+    cluster, in ``shards`` slices (default: four per worker, at most one
+    per trial), each slice a task running ``attsync mc --shard K/N`` on a
+    worker (``jobs`` trials at once there; default: the worker's cores), then
+    merged here as ``attsync mc merge`` does. Every trial draws from its own
+    seed, so the results (and the files in ``out``) are those of a local
+    run, bit for bit. The workers need the ``attsync`` package, not the
+    scenario file (its text is sent)."""
+    if client is not None:
+        return _mc_on(client, _scenario(scenario), int(trials), int(seed), engine, out, jobs, law, shards)
     adapter = None if law is None else _adapter(law)
     return _table(_attsync.mc, scenario, out, "trials.csv", int(trials), int(seed), engine=engine, jobs=jobs,
                   law=adapter)
+
+
+#: The files of a shard that ``attsync mc merge`` reads.
+_SHARD_FILES = ("trials.csv", "initial.csv", "mc.json")
+
+
+def _mc_shard(name: str, text: str, sets: list, trials: int, seed: int, engine: str, jobs, law,
+              shard: tuple) -> dict:
+    """One slice of a Monte Carlo, run where this is called (a Dask task):
+    the scenario's text written under its own file name (its name is the
+    file's stem), the shard run, its files returned as text."""
+    with tempfile.TemporaryDirectory(prefix="attsync-shard-") as tmp:
+        path = Path(tmp) / name
+        path.write_text(text)
+        out = Path(tmp) / "out"
+        adapter = None if law is None else _adapter(law)
+        _native(_attsync.mc, str(path), list(sets), trials, seed, out, engine=engine, jobs=jobs, law=adapter,
+                shard=shard)
+        return {f: (out / f).read_text() for f in _SHARD_FILES}
+
+
+def _mc_on(client, sc: Scenario, trials: int, seed: int, engine: str, out, jobs, law, shards) -> pd.DataFrame:
+    """:func:`mc` on a Dask cluster: one task per shard, merged here."""
+    if shards is None:
+        workers = len(client.scheduler_info().get("workers", {})) or 1
+        shards = min(trials, 4 * workers)
+    shards = int(shards)
+    if not 1 <= shards <= trials:
+        raise ValueError(f"shards = {shards}: between 1 and the number of trials ({trials})")
+    text = sc.path.read_text()
+    tasks = [
+        client.submit(_mc_shard, sc.path.name, text, sc.sets, trials, seed, engine, jobs, law, (k, shards),
+                      pure=False)
+        for k in range(1, shards + 1)
+    ]
+    parts = client.gather(tasks)
+    return _rows(out, "trials.csv", lambda o: _merge_parts(parts, o))
+
+
+def _merge_parts(parts: list, out: Path) -> None:
+    """Writes each shard's files (as :func:`_mc_shard` returned them) into
+    a directory of its own, then merges them into ``out``."""
+    with tempfile.TemporaryDirectory(prefix="attsync-shards-") as tmp:
+        dirs = []
+        for k, files in enumerate(parts, start=1):
+            d = Path(tmp) / f"shard-{k}"
+            d.mkdir()
+            for f, content in files.items():
+                (d / f).write_text(content)
+            dirs.append(str(d))
+        _attsync.mc_merge(dirs, out)
+
+
+def mc_merge(dirs, out) -> pd.DataFrame:
+    """``attsync mc merge DIRS… --out OUT``: joins the directories of one
+    Monte Carlo's shards (``attsync mc --shard K/N``, every K of one N) into
+    ``out``, the files one run of every trial writes, byte for byte;
+    returns the rows of its ``trials.csv``. Shards that do not make one
+    whole Monte Carlo raise :class:`RunError` naming the directory and what
+    is wrong (nothing is written)."""
+    _attsync.mc_merge([str(d) for d in dirs], Path(out))
+    df = pd.read_csv(Path(out) / "trials.csv", float_precision="round_trip")
+    df.attrs["dir"] = str(out)
+    return df
 
 
 def margin(scenario) -> dict:

@@ -216,9 +216,9 @@ fn sweep(
     }
 }
 
-/// `attsync mc PATH --trials N --seed S --out OUT` with `sets`.
+/// `attsync mc PATH --trials N --seed S --out OUT [--shard K/N]` with `sets`.
 #[pyfunction]
-#[pyo3(signature = (path, sets, trials, seed, out, engine="in-process", jobs=None, law=None))]
+#[pyo3(signature = (path, sets, trials, seed, out, engine="in-process", jobs=None, law=None, shard=None))]
 #[allow(clippy::too_many_arguments)]
 fn mc(
     py: Python<'_>,
@@ -230,9 +230,11 @@ fn mc(
     engine: &str,
     jobs: Option<usize>,
     law: Option<Py<PyAny>>,
+    shard: Option<(u64, u64)>,
 ) -> PyResult<()> {
     let law = law.map(|f| Arc::new(PyLaw::new(f)));
     use attsync::mc::{self as m, McOptions};
+    let shard = shard.map(|(index, count)| m::Shard { index, count });
     let base = load(path, &sets)?;
     let engine = engine_of(engine)?;
     let nodes = base.resolved.network.agents.len() + 1;
@@ -254,6 +256,7 @@ fn mc(
         progress: false,
         stiffness: scenario::StiffnessCheck::Refuse,
         law: law.clone().map(|l| l as attitude::law::SharedLaw),
+        shard,
     };
     let interrupt = Interrupt::new();
     let done = watched(py, &interrupt, || m::monte_carlo(&o, &interrupt))?;
@@ -265,6 +268,14 @@ fn mc(
         Err(m::McError::Scenario(e)) => Err(scenario_error(&e)),
         Err(e) => Err(RunError::new_err((e.to_string(), e.exit_code()))),
     }
+}
+
+/// `attsync mc merge DIRS… --out OUT`.
+#[pyfunction]
+fn mc_merge(dirs: Vec<PathBuf>, out: PathBuf) -> PyResult<()> {
+    attsync::mc::merge(&dirs, &out)
+        .map(drop)
+        .map_err(|e| RunError::new_err((e.to_string(), e.exit_code())))
 }
 
 /// `attsync margin PATH --json` with `sets`: the delay margin of the
@@ -316,10 +327,17 @@ fn _attsync(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(mc, m)?)?;
+    m.add_function(wrap_pyfunction!(mc_merge, m)?)?;
     m.add_function(wrap_pyfunction!(margin, m)?)?;
     m.add("ScenarioError", m.py().get_type::<ScenarioError>())?;
     m.add("RunError", m.py().get_type::<RunError>())?;
     m.add("LawError", m.py().get_type::<LawError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // Each agent's look in every figure (orchestrator/src/results/palette.rs).
+    m.add(
+        "PALETTE_COLOURS",
+        attsync::results::palette::COLOURS.to_vec(),
+    )?;
+    m.add("PALETTE_DASHES", attsync::results::palette::DASHES.to_vec())?;
     Ok(())
 }

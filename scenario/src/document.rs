@@ -25,6 +25,12 @@ impl Document {
         }
     }
 
+    /// The overrides (`--set key.path=value`), in the order given.
+    #[must_use]
+    pub fn sets(&self) -> &[String] {
+        &self.sets
+    }
+
     /// This document with one more override `set` (`key.path=value`),
     /// which must apply (a field the scenario already validated).
     #[must_use]

@@ -111,7 +111,12 @@ pub fn monte_carlo(o: &McOptions, interrupt: &Interrupt) -> Result<McRun, McErro
     let results = run_pool(&base, o, staging.path(), interrupt)?;
     let wall_seconds = started.elapsed().as_secs_f64();
     let summary = report::summarise(head(&base, o), &results);
-    write_files(&base, staging.path(), &summary, &results)?;
+    let files = Files {
+        header: report::trials_header(&base.dispersion),
+        initial: initial_csv(&base, &results),
+        planned: o.range().end - o.range().start,
+    };
+    files.write(staging.path(), &summary, &results)?;
     staging.commit().map_err(io_at(&o.out))?;
     if let Some(signal) = interrupt.signal() {
         return Err(McError::Interrupted(signal));
@@ -134,6 +139,7 @@ fn head(base: &Base, o: &McOptions) -> McSummary {
         trials: o.trials,
         trials_run: 0,
         complete: false,
+        shard: o.shard.map(|s| s.of(o.trials)),
         duration: net.steps as f64 * net.dt,
         tolerance: o.judging.tolerance,
         until: match o.judging.until {
@@ -182,7 +188,7 @@ fn one(
     }
 }
 
-/// Trials `0..o.trials` on `o.jobs` workers; the results by index (those
+/// Trials `o.range()` on `o.jobs` workers; the results by index (those
 /// an interrupt prevented are missing). The first failed trial (by index)
 /// stops the pool and is the error.
 fn run_pool(
@@ -191,12 +197,13 @@ fn run_pool(
     dir: &Path,
     interrupt: &Interrupt,
 ) -> Result<Vec<TrialResult>, McError> {
-    let bar = crate::progress::of_jobs(o.progress, o.trials, "trials");
+    let trials = o.range();
+    let bar = crate::progress::of_jobs(o.progress, trials.end - trials.start, "trials");
     let ran = crate::pool::run(
-        o.trials as usize,
+        (trials.end - trials.start) as usize,
         o.jobs,
         || interrupt.is_set(),
-        |k| match one(base, o, k as u64, dir, interrupt) {
+        |k| match one(base, o, trials.start + k as u64, dir, interrupt) {
             Ok(Ran::Done(r)) => {
                 bar.inc(1);
                 Flow::Next(Ok(r))
@@ -209,40 +216,58 @@ fn run_pool(
     ran.into_iter().flatten().collect()
 }
 
-/// `trials.csv`, `initial.csv` (draws recomputed from each trial's seed),
-/// `mc.svg`, then `mc.json`.
-fn write_files(
-    base: &Base,
-    dir: &Path,
-    s: &McSummary,
-    results: &[TrialResult],
-) -> Result<(), McError> {
-    let files = layout::McLayout::new(dir);
-    let write =
-        |path: std::path::PathBuf, text: &str| std::fs::write(&path, text).map_err(io_at(&path));
-    write(
-        files.trials(),
-        &report::trials_csv(&base.dispersion, results),
-    )?;
+/// `initial.csv` of `results`: their draws, recomputed from each trial's seed.
+fn initial_csv(base: &Base, results: &[TrialResult]) -> String {
     let ids: Vec<u32> = (base.loaded.scenario.agents.iter()).map(|a| a.id).collect();
     let mut initial = format!("{}\n", report::INITIAL_HEADER);
     for r in results {
         let draws = super::draws::draw(&base.dispersion, &mut super::trial_rng(r.seed));
         report::initial_rows(&mut initial, r.trial, &ids, &base.dispersion, &draws);
     }
-    write(files.initial(), &initial)?;
-    let svg = files.svg();
-    let title = format!("{}: {} trials, seed {}", s.scenario, s.trials_run, s.seed);
-    plot::draw(&svg, &title, results).map_err(|crate::results::plot::PlotError(message)| {
-        McError::Plot {
-            path: svg.clone(),
-            message,
-        }
-    })?;
-    let mut s = s.clone();
-    s.complete = s.trials_run == s.trials;
-    let json = serde_json::to_string_pretty(&s).expect("json") + "\n";
-    write(files.json(), &json)
+    initial
+}
+
+/// What a Monte Carlo's directory holds besides `mc.json`, made ready
+/// (by a run or by [`super::merge`]).
+pub(super) struct Files {
+    /// `trials.csv`'s header.
+    pub header: String,
+    /// `initial.csv`, whole.
+    pub initial: String,
+    /// The trials planned (all, or a shard's): `complete` when all ran.
+    pub planned: u64,
+}
+
+impl Files {
+    /// Writes `trials.csv`, `initial.csv`, `mc.svg`, then `mc.json` into `dir`.
+    pub(super) fn write(
+        &self,
+        dir: &Path,
+        s: &McSummary,
+        results: &[TrialResult],
+    ) -> Result<(), McError> {
+        let files = layout::McLayout::new(dir);
+        let write = |path: std::path::PathBuf, text: &str| {
+            std::fs::write(&path, text).map_err(io_at(&path))
+        };
+        write(
+            files.trials(),
+            &report::trials_csv_under(&self.header, results),
+        )?;
+        write(files.initial(), &self.initial)?;
+        let svg = files.svg();
+        let title = format!("{}: {} trials, seed {}", s.scenario, s.trials_run, s.seed);
+        plot::draw(&svg, &title, results).map_err(|crate::results::plot::PlotError(message)| {
+            McError::Plot {
+                path: svg.clone(),
+                message,
+            }
+        })?;
+        let mut s = s.clone();
+        s.complete = s.trials_run == self.planned;
+        let json = serde_json::to_string_pretty(&s).expect("json") + "\n";
+        write(files.json(), &json)
+    }
 }
 
 /// One trial run alone as a normal run.

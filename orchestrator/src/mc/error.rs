@@ -51,6 +51,9 @@ pub enum McError {
         /// What went wrong.
         message: String,
     },
+    /// `attsync mc merge`: the directories are not one Monte Carlo's shards.
+    #[error(transparent)]
+    Merge(#[from] super::merge::MergeError),
     /// A signal stopped the Monte Carlo (the number); the trials done are kept.
     #[error("{}", crate::interrupt::reason(*.0))]
     Interrupted(i32),
@@ -68,9 +71,10 @@ impl McError {
     #[must_use]
     pub fn exit_code(&self) -> u8 {
         match self {
-            McError::Scenario(_) | McError::Options(_) | McError::Capacity(_) => {
-                crate::exit::INVALID
-            }
+            McError::Scenario(_)
+            | McError::Options(_)
+            | McError::Capacity(_)
+            | McError::Merge(_) => crate::exit::INVALID,
             McError::Interrupted(signal) => crate::interrupt::exit_code(*signal),
             McError::Run(e) => e.exit_code(),
             _ => crate::exit::FAILED,

@@ -18,6 +18,8 @@
 //! - [`stats`]: exact binomial (Clopper–Pearson) bounds.
 //! - [`report`]: `trials.csv`, `initial.csv`, `mc.json`, the stdout table.
 //! - `plot`: `mc.svg`.
+//! - [`shard`]: `--shard K/N`, a slice of the trials; [`merge`]: `attsync
+//!   mc merge`, the slices joined into one run's files.
 //! - [`options`], `error`, `driver`: [`McOptions`], [`McError`], and
 //!   [`monte_carlo`] / [`trial_alone`] (the work queue, the files).
 
@@ -26,12 +28,14 @@ pub mod draws;
 mod driver;
 mod error;
 pub mod haar;
+pub mod merge;
 pub mod options;
 pub mod outcome;
 pub mod params;
 mod plot;
 pub mod report;
 mod seed;
+pub mod shard;
 pub mod stats;
 pub mod trial;
 
@@ -39,6 +43,8 @@ pub use dispersion::{Dispersion, MonteCarloSpec};
 pub use driver::{Alone, McRun, load_base, monte_carlo, run_command, trial_alone};
 pub use error::McError;
 pub use haar::{angle_of, bounded_vector, haar_quaternion, unit_vector};
+pub use merge::{MergeError, merge};
 pub use options::McOptions;
 pub use outcome::{Outcome, Trace, TrialResult};
 pub use seed::{trial_rng, trial_seed};
+pub use shard::Shard;

@@ -39,11 +39,13 @@ pub struct McOptions {
     /// A control law from outside in place of the scheme's (in-process only;
     /// [`attitude::law`]).
     pub law: Option<attitude::law::SharedLaw>,
+    /// `--shard K/N`: only that slice of the trials ([`super::shard`]).
+    pub shard: Option<super::shard::Shard>,
 }
 
 impl McOptions {
-    /// Checks `--trials`, `--jobs`, `--tolerance`, `--max-duration` and the
-    /// process engine's timeouts.
+    /// Checks `--trials`, `--jobs`, `--tolerance`, `--max-duration`,
+    /// `--shard` and the process engine's timeouts.
     ///
     /// # Errors
     /// The first option out of its range.
@@ -51,8 +53,17 @@ impl McOptions {
         options::count("--trials", self.trials, 1, u64::MAX)?;
         options::count("--jobs", self.jobs as u64, 1, u64::MAX)?;
         self.judging.validate()?;
+        if let Some(shard) = self.shard {
+            shard.check(self.trials)?;
+        }
         options::seconds("--stage-timeout", self.processes.stage_timeout)?;
         options::seconds("--start-timeout", self.processes.start_timeout)
+    }
+
+    /// The trials this run makes: all, or its `--shard`'s slice.
+    #[must_use]
+    pub fn range(&self) -> std::ops::Range<u64> {
+        self.shard.map_or(0..self.trials, |s| s.range(self.trials))
     }
 }
 

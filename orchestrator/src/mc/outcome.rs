@@ -10,10 +10,10 @@ use attitude::engine::Snapshot;
 use attitude::metrics::{errors, spread};
 use attitude::network::Network;
 use attsync_verdict::Kind;
-use serde::Serialize;
+use serde::{Deserialize, Deserializer, Serialize};
 
 /// How a trial ended: its verdict, or that a node process failed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Outcome {
     /// The largest attitude error over agents is below the tolerance and stays there.
@@ -67,6 +67,12 @@ impl Outcome {
     #[must_use]
     pub fn is_failure(self) -> bool {
         !matches!(self, Outcome::Converged | Outcome::Converging)
+    }
+
+    /// The outcome named `name` in `trials.csv` ([`Outcome::name`]).
+    #[must_use]
+    pub fn named(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|o| o.name() == name)
     }
 
     /// Every outcome, in the order of the summary table.
@@ -195,8 +201,10 @@ impl Trace {
     }
 }
 
-/// One trial's result: a row of `trials.csv`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// One trial's result: a row of `trials.csv` (and, read back by `attsync
+/// mc merge`, an entry of `mc.json` `slowest`, where JSON writes NaN as
+/// `null`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrialResult {
     /// Trial index (0-based).
     pub trial: u64,
@@ -207,21 +215,29 @@ pub struct TrialResult {
     /// The verdict's decay rate, 1/s (negative = decaying).
     pub decay_rate: Option<f64>,
     /// Largest final attitude error over agents (at the last sample).
+    #[serde(deserialize_with = "nan_if_null")]
     pub final_max_att_err: f64,
     /// Largest final angular-velocity error over agents, rad/s.
+    #[serde(deserialize_with = "nan_if_null")]
     pub final_max_angvel_err: f64,
     /// Time of the last sample, s.
+    #[serde(deserialize_with = "nan_if_null")]
     pub t_end: f64,
     /// When the largest errors over agents settled ([`Settle`]).
     #[serde(flatten)]
     pub settle: Settle,
     /// Why a diverged or failed trial stopped.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
     /// The values of the `[[monte_carlo.param]]` fields the trial ran
     /// with, in file order, read back from its scenario.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub params: Vec<f64>,
+}
+
+/// A number JSON wrote as `null` (serde_json's NaN or infinity) read back as NaN.
+fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// Classifies a trial that ended as `end` with `trace` recorded, by its

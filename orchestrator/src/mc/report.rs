@@ -8,7 +8,7 @@ use super::dispersion::{Dispersion, LeaderDispersion, Quantity};
 use super::draws::Draws;
 use super::outcome::{Outcome, TrialResult};
 use super::stats;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 
 /// The exact header of `trials.csv`.
@@ -64,12 +64,74 @@ pub fn trial_row(r: &TrialResult) -> String {
 /// `trials.csv`.
 #[must_use]
 pub fn trials_csv(dispersion: &Dispersion, results: &[TrialResult]) -> String {
-    let mut s = format!("{}\n", trials_header(dispersion));
+    trials_csv_under(&trials_header(dispersion), results)
+}
+
+/// `trials.csv` under the header `header` ([`trials_header`]).
+#[must_use]
+pub fn trials_csv_under(header: &str, results: &[TrialResult]) -> String {
+    let mut s = format!("{header}\n");
     for r in results {
         s += &trial_row(r);
         s.push('\n');
     }
     s
+}
+
+/// Why a `trials.csv` row cannot be read back.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("column {column}: {reason}")]
+pub struct RowError {
+    /// The column's name.
+    pub column: String,
+    /// What is wrong.
+    pub reason: String,
+}
+
+/// Reads back a row [`trial_row`] wrote under `header` (its exact header,
+/// [`trials_header`]): every number is in its shortest round-trip form, so
+/// the result is the one written, bit for bit, except `reason` (not in
+/// the file: `None`).
+///
+/// # Errors
+/// A cell that is missing or is not what its column holds.
+pub fn parse_row(header: &str, row: &str) -> Result<TrialResult, RowError> {
+    let names: Vec<&str> = header.split(',').collect();
+    let cells: Vec<&str> = row.split(',').collect();
+    let column = |k: usize| names.get(k).copied().unwrap_or("?").to_string();
+    if cells.len() != names.len() || names.len() < 11 {
+        return Err(RowError {
+            column: column(cells.len().min(names.len())),
+            reason: format!("{} cells under a header of {}", cells.len(), names.len()),
+        });
+    }
+    let bad = |k: usize, what: &str| RowError {
+        column: column(k),
+        reason: format!("{:?} is not {what}", cells[k]),
+    };
+    let int = |k: usize| cells[k].parse::<u64>().map_err(|_| bad(k, "an integer"));
+    let num = |k: usize| cells[k].parse::<f64>().map_err(|_| bad(k, "a number"));
+    let opt = |k: usize| match cells[k] {
+        "" => Ok(None),
+        _ => num(k).map(Some),
+    };
+    Ok(TrialResult {
+        trial: int(0)?,
+        seed: int(1)?,
+        outcome: Outcome::named(cells[2]).ok_or_else(|| bad(2, "an outcome"))?,
+        decay_rate: opt(3)?,
+        final_max_att_err: num(4)?,
+        final_max_angvel_err: num(5)?,
+        t_end: num(6)?,
+        settle: crate::results::summary::Settle {
+            att_1e3: opt(7)?,
+            att_1e6: opt(8)?,
+            angvel_1e3: opt(9)?,
+            angvel_1e6: opt(10)?,
+        },
+        reason: None,
+        params: (11..cells.len()).map(num).collect::<Result<_, _>>()?,
+    })
 }
 
 /// The cells of `values` if `drawn`, else as many empty cells.
@@ -109,7 +171,7 @@ pub fn initial_rows(s: &mut String, trial: u64, ids: &[u32], d: &Dispersion, dra
 }
 
 /// Counts of each outcome.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
     /// Converged.
     pub converged: u64,
@@ -166,7 +228,7 @@ impl Counts {
 }
 
 /// `mc.json`.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct McSummary {
     /// attsync's version.
     pub attsync_version: String,
@@ -180,8 +242,12 @@ pub struct McSummary {
     pub trials: u64,
     /// Trials that ran to an outcome (fewer if interrupted).
     pub trials_run: u64,
-    /// Whether every trial asked for ran.
+    /// Whether every trial asked for ran (of a shard: every trial of its slice).
     pub complete: bool,
+    /// `--shard K/N`: the slice of the trials this directory holds
+    /// (`attsync mc merge` joins the slices).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<super::shard::ShardRange>,
     /// Simulated horizon of each trial, s (the scenario's; `--until
     /// settled` may extend a trial's: its `t_end`).
     pub duration: f64,

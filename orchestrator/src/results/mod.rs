@@ -25,6 +25,7 @@ pub mod envelope;
 pub mod layout;
 pub mod lock;
 pub mod manifest;
+pub mod palette;
 pub mod platform;
 pub mod plot;
 pub mod staging;

@@ -9,11 +9,16 @@
 //! [`EACH_AGENT_UP_TO`] agents is drawn as the band of its agents' errors,
 //! and every line is thinned to [`POINTS_PER_LINE`] points (`envelope.rs`).
 //!
+//! Every agent has the look [`super::palette`] gives it (a colour-blind-safe
+//! colour and a dash pattern), the same as in the 3D view and `Run.plot()`;
+//! every panel names its quantity on its y axis, in the paper's symbols.
+//!
 //! Also the look every attsync chart shares (`errors.svg` here, `mc.svg` in
 //! `mc/plot.rs`): `canvas`, `chart`, `line`, `bars`, `legend`.
 
 use super::Series;
 use super::envelope::{Band, EACH_AGENT_UP_TO, POINTS_PER_LINE, band, decimate};
+use super::palette;
 use super::summary::LinkSummary;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -37,14 +42,39 @@ const FLOOR: f64 = 1e-16;
 /// Height of one panel, px.
 const PANEL_HEIGHT: u32 = 450;
 
-/// Caption of the observer's attitude-error panel.
-pub const OBSERVER_ATT: &str = "observer attitude error |Rhat_i R_0^T|_I";
-/// Caption of the observer's angular-velocity-error panel.
-pub const OBSERVER_ANGVEL: &str = "observer angular velocity error ||what_i - w_0|| (rad/s)";
+/// Caption and y label of the attitude-error panel (R̃ᵢ = Rᵢ R₀ᵀ).
+pub const ATT: (&str, &str) = ("attitude error to the leader, R̃ᵢ = Rᵢ R₀ᵀ", "|R̃ᵢ|_I");
+/// Caption and y label of the angular-velocity-error panel.
+pub const ANGVEL: (&str, &str) = ("angular-velocity error to the leader", "‖ωᵢ − ω₀‖ (rad/s)");
+/// Caption and y label of the observer's attitude-error panel.
+pub const OBSERVER_ATT: (&str, &str) = ("attitude error of the observer", "|R̂ᵢ R₀ᵀ|_I");
+/// Caption and y label of the observer's angular-velocity-error panel.
+pub const OBSERVER_ANGVEL: (&str, &str) = (
+    "angular-velocity error of the observer",
+    "‖ω̂ᵢ − ω₀‖ (rad/s)",
+);
 /// Caption of the age-of-information panel.
-pub const AOI: &str = "age of information per link (ms): mean and max";
-/// Caption of the torque panel (drawn on request).
-pub const TORQUE: &str = "applied torque ‖τᵢ‖ (N·m)";
+pub const AOI: &str = "age of information per link: mean and largest (log scale)";
+/// Caption and y label of the torque panel (drawn on request).
+pub const TORQUE: (&str, &str) = ("applied torque", "‖τᵢ‖ (N·m)");
+
+/// Longest title drawn, characters (a longer one ends in `…`).
+const TITLE_CHARS: usize = 110;
+
+/// The title of a run's `errors.svg`: its scenario and engine, then every
+/// `--set` it was given (a delayed run is not titled as the undelayed one).
+#[must_use]
+pub fn title(s: &super::Summary) -> String {
+    let mut t = format!("{} ({})", s.scenario, s.engine);
+    if !s.overrides.is_empty() {
+        t += " · ";
+        t += &s.overrides.join(", ");
+    }
+    if t.chars().count() > TITLE_CHARS {
+        t = t.chars().take(TITLE_CHARS - 1).collect::<String>() + "…";
+    }
+    t
+}
 
 /// A moment marked on every time axis: a vertical line, labelled in the
 /// first panel (a scenario's `[[event]]`).
@@ -75,15 +105,8 @@ pub fn draw(
     let areas = root.split_evenly((panels, 1));
     let labelled = (marks, true);
     let unlabelled = (marks, false);
-    panel(
-        &areas[0],
-        "attitude error |R_i R_0^T|_I",
-        series,
-        labelled,
-        |s| &s.att,
-    )?;
-    let angvel = "angular velocity error ||w_i - w_0|| (rad/s)";
-    panel(&areas[1], angvel, series, unlabelled, |s| &s.angvel)?;
+    panel(&areas[0], ATT, series, labelled, |s| &s.att)?;
+    panel(&areas[1], ANGVEL, series, unlabelled, |s| &s.angvel)?;
     let mut next = 2;
     if torque {
         let torques = (&torques(series)[..], t_end(series));
@@ -130,15 +153,27 @@ fn aoi_bars<DB: DrawingBackend>(
     links: &[LinkSummary],
 ) -> Result<(), PlotError> {
     let n = links.len();
-    let ms = |x: f64| if x.is_finite() { x * 1e3 } else { 0.0 };
-    let top = links
-        .iter()
-        .map(|l| ms(l.aoi_max))
-        .fold(0.0, f64::max)
-        .max(1e-6)
-        * 1.15;
+    // Milliseconds; an unmeasured age (NaN) or zero is drawn as no bar.
+    let ms = |x: f64| {
+        if x.is_finite() && x > 0.0 {
+            x * 1e3
+        } else {
+            0.0
+        }
+    };
+    let ages = links.iter().flat_map(|l| [ms(l.aoi_mean), ms(l.aoi_max)]);
+    let (lo, hi) = ages
+        .filter(|&x| x > 0.0)
+        .fold((f64::INFINITY, 0.0_f64), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        });
+    let (lo, hi) = if lo.is_finite() {
+        (lo / 2.0, hi * 2.0)
+    } else {
+        (1e-3, 1.0)
+    };
     let mut chart = chart(area, AOI, 70)
-        .build_cartesian_2d(-0.5..n as f64 - 0.5, 0.0..top)
+        .build_cartesian_2d(-0.5..n as f64 - 0.5, (lo..hi).log_scale())
         .map_err(PlotError::of)?;
     let label = |x: &f64| {
         let k = x.round();
@@ -152,20 +187,23 @@ fn aoi_bars<DB: DrawingBackend>(
         .x_desc("link (from → to, 0 = leader)")
         .x_labels(n.min(40) + 1)
         .x_label_formatter(&label)
-        .y_desc("ms")
+        .y_desc("age of information (ms)")
+        .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(PlotError::of)?;
     let kinds = [
-        ("mean age", 0.0, Palette99::pick(0)),
-        ("max age", 0.4, Palette99::pick(1)),
+        ("mean age", 0.0, palette::colour(0)),
+        ("largest age", 0.4, palette::colour(1)),
     ];
     for (name, off, color) in kinds {
         let color = color.to_rgba();
         let pick = |l: &LinkSummary| if off == 0.0 { l.aoi_mean } else { l.aoi_max };
-        let rects = links.iter().enumerate().map(|(k, l)| {
-            let x = k as f64 - 0.4 + off;
-            Rectangle::new([(x, 0.0), (x + 0.4, ms(pick(l)))], color.filled())
-        });
+        let rects = (links.iter().enumerate())
+            .filter(|(_, l)| ms(pick(l)) > 0.0)
+            .map(|(k, l)| {
+                let x = k as f64 - 0.4 + off;
+                Rectangle::new([(x, lo), (x + 0.4, ms(pick(l)))], color.filled())
+            });
         bars(&mut chart, rects, name, color.filled(), 16)?;
     }
     legend(&mut chart, SeriesLabelPosition::UpperRight)
@@ -182,7 +220,7 @@ fn t_end(series: &[Series]) -> f64 {
 
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    label: &str,
+    label: (&str, &str),
     series: &[Series],
     marks: (&[Mark], bool),
     pick: impl Fn(&Series) -> &[f64],
@@ -193,7 +231,7 @@ fn panel<DB: DrawingBackend>(
 /// [`panel`] with a time axis to `t_end`.
 fn panel_until<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    label: &str,
+    (caption, y): (&str, &str),
     (series, t_end): (&[Series], f64),
     (marks, labelled): (&[Mark], bool),
     pick: impl Fn(&Series) -> &[f64],
@@ -209,12 +247,13 @@ fn panel_until<DB: DrawingBackend>(
     } else {
         (FLOOR, 1.0)
     };
-    let mut chart = chart(area, label, 70)
+    let mut chart = chart(area, caption, 90)
         .build_cartesian_2d(0.0..t_end, (lo..hi).log_scale())
         .map_err(PlotError::of)?;
     chart
         .configure_mesh()
         .x_desc("t (s)")
+        .y_desc(y)
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(PlotError::of)?;
@@ -222,10 +261,10 @@ fn panel_until<DB: DrawingBackend>(
         band_of_agents(&mut chart, series.len(), &band(series, &pick))?;
     } else {
         for (k, s) in series.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
+            let style = palette::colour(k).stroke_width(2);
             let points = decimate(&s.t, pick(s), POINTS_PER_LINE);
             let name = format!("agent {}", s.id);
-            line(&mut chart, floored(points), color.stroke_width(2), name)?;
+            dashed(&mut chart, floored(points), (style, palette::dash(k)), name)?;
         }
     }
     mark(&mut chart, marks, (lo, hi), labelled)?;
@@ -275,7 +314,7 @@ where
     let upper = floored(decimate(&b.t, &b.max, POINTS_PER_LINE));
     let lower = floored(decimate(&b.t, &b.min, POINTS_PER_LINE));
     let outline: Vec<(f64, f64)> = upper.clone().chain(lower.clone().rev()).collect();
-    let shade = Palette99::pick(0).mix(0.2).filled();
+    let shade = palette::colour(0).mix(0.2).filled();
     (chart.draw_series(std::iter::once(Polygon::new(outline, shade)))).map_err(PlotError::of)?;
     let lines = [
         (
@@ -291,12 +330,8 @@ where
         ("smallest".into(), lower.collect(), 3),
     ];
     for (name, points, k) in lines {
-        line(
-            chart,
-            points,
-            Palette99::pick(k).to_rgba().stroke_width(2),
-            name,
-        )?;
+        let style = palette::colour(k).stroke_width(2);
+        dashed(chart, points, (style, palette::dash(k)), name)?;
     }
     Ok(())
 }
@@ -352,6 +387,36 @@ where
         .map_err(PlotError::of)?
         .label(label)
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+    Ok(())
+}
+
+/// Draws `points` as a line in `style` with the dash pattern `dash`
+/// (`None`: solid; [`palette::dash`]), and 24 px of it beside `label` in
+/// the legend.
+pub(crate) fn dashed<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    (style, dash): (ShapeStyle, Option<(u32, u32)>),
+    label: impl Into<String>,
+) -> Result<(), PlotError>
+where
+    DB: DrawingBackend + 'a,
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let (on, off) = dash.map_or((24, 0), |(on, off)| (on as i32, off as i32));
+    let drawn = match dash {
+        None => chart.draw_series(LineSeries::new(points, style)),
+        Some(_) => {
+            let points: Vec<(f64, f64)> = points.into_iter().collect();
+            chart.draw_series(DashedLineSeries::new(points, on, off, style))
+        }
+    };
+    drawn
+        .map_err(PlotError::of)?
+        .label(label)
+        .legend(move |(x, y)| {
+            plotters::element::DashedPathElement::new(vec![(x, y), (x + 24, y)], on, off, style)
+        });
     Ok(())
 }
 
@@ -433,8 +498,8 @@ mod tests {
             s.torque = vec![2.0, 0.5, f64::NAN];
         }
         let text = svg_with(&with, &[], true);
-        assert!(text.contains(TORQUE) && text.contains(OBSERVER_ATT));
-        assert!(!svg(&with, &[]).contains(TORQUE));
+        assert!(text.contains(TORQUE.0) && text.contains(OBSERVER_ATT.0));
+        assert!(!svg(&with, &[]).contains(TORQUE.0));
         assert_eq!(
             svg(&with, &[]),
             svg(&series(true), &[]),
@@ -450,11 +515,14 @@ mod tests {
     #[test]
     fn the_observer_errors_are_drawn_where_the_scheme_has_them() {
         let with = svg(&series(true), &[]);
-        assert!(with.contains(OBSERVER_ATT) && with.contains(OBSERVER_ANGVEL));
+        assert!(with.contains(OBSERVER_ATT.0) && with.contains(OBSERVER_ANGVEL.1));
         assert!(!with.contains(AOI));
         let without = svg(&series(false), &[]);
-        assert!(!without.contains(OBSERVER_ATT) && !without.contains(OBSERVER_ANGVEL));
-        assert!(without.contains("attitude error |R_i R_0^T|_I"));
+        assert!(!without.contains(OBSERVER_ATT.0) && !without.contains(OBSERVER_ANGVEL.1));
+        // The y axes say what they show, in the paper's symbols.
+        for (_, y) in [ATT, ANGVEL] {
+            assert!(without.contains(y), "no y label {y}");
+        }
     }
 
     fn agents(n: u32, samples: usize) -> Vec<Series> {
@@ -485,6 +553,26 @@ mod tests {
         assert!(
             (b / a - 1.0).abs() < 0.1,
             "{a} B for 100 agents, {b} B for 5000"
+        );
+    }
+
+    #[test]
+    fn every_agent_has_a_colour_and_dash_of_its_own_as_in_the_palette() {
+        let text = svg(&agents(10, 50), &[]);
+        // Agents 1–7: the seven colours.
+        for k in 0..7 {
+            let hex = palette::colour_hex(k);
+            assert!(text.contains(hex), "agent {}: {hex} not drawn", k + 1);
+        }
+        // Agents 8–10 take the colours again, dashed: a dashed line is drawn
+        // as many short paths, so the drawing has far more than ten.
+        let solid = svg(&agents(7, 50), &[]);
+        let paths = |t: &str| t.matches("<polyline").count() + t.matches("<line").count();
+        assert!(
+            paths(&text) > paths(&solid) + 30,
+            "{} {}",
+            paths(&text),
+            paths(&solid)
         );
     }
 

@@ -126,6 +126,9 @@ pub struct Summary {
     pub attsync_version: String,
     /// Scenario name.
     pub scenario: String,
+    /// The `--set` overrides the run was given (`key.path=value`), in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub overrides: Vec<String>,
     /// Engine used.
     pub engine: String,
     /// `scheme.law`: `corrected`, or `as-printed` (the negative control of

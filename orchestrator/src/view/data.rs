@@ -74,6 +74,18 @@ pub struct ViewData {
     pub edges: Vec<[usize; 2]>,
     /// The trajectory.
     pub frames: Frames,
+    /// Each agent's look, as in `errors.svg` ([`crate::results::palette`]).
+    pub palette: Palette,
+}
+
+/// [`crate::results::palette`], for the page.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Palette {
+    /// Colours, `#RRGGBB`: agent `k` (0-based) has `colours[k mod len]`.
+    pub colours: &'static [&'static str],
+    /// Dash patterns (drawn, gap) px, `(0, 0)` solid: agent `k` has
+    /// `dashes[(k div len(colours)) mod len]`.
+    pub dashes: &'static [(u32, u32)],
 }
 
 /// The data of a run of `net` that recorded `frames`.
@@ -119,6 +131,10 @@ pub fn view_data(net: &Network, run: RunInfo, frames: Frames) -> ViewData {
         bodies,
         edges,
         frames,
+        palette: Palette {
+            colours: &crate::results::palette::COLOURS,
+            dashes: &crate::results::palette::DASHES,
+        },
     }
 }
 

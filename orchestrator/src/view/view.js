@@ -20,10 +20,21 @@
 
   const state = { t: T0, playing: true, speed: 1, yaw: -0.9, pitch: 0.62, zoom: 1, dirty: true, last: null };
 
-  // ---- colours -------------------------------------------------------
-  function agentHue(k) { return (210 + (k * 360) / Math.max(NB - 1, 1)) % 360; }
+  // ---- colours: errors.svg's palette (results/palette.rs) -------------
+  const PAL = D.palette;
+  /** Agent k's colour (0-based), shaded: light 58 is the palette's own,
+   *  less is darker (towards black), more is lighter (towards white). */
   function agentColor(k, light, alpha) {
-    return 'hsla(' + agentHue(k) + ',62%,' + light + '%,' + (alpha === undefined ? 1 : alpha) + ')';
+    const hex = PAL.colours[k % PAL.colours.length];
+    const c = [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
+    const f = light / 58;
+    const m = c.map((x) => Math.round(f <= 1 ? x * f : x + ((255 - x) * (light - 58)) / 42));
+    return 'rgba(' + m.join(',') + ',' + (alpha === undefined ? 1 : alpha) + ')';
+  }
+  /** Agent k's dash pattern ([] solid), in px at a device pixel ratio of 1. */
+  function agentDash(k) {
+    const d = PAL.dashes[Math.floor(k / PAL.colours.length) % PAL.dashes.length];
+    return d[0] ? d : [];
   }
   const AXIS = ['#ff5c5c', '#5cd65c', '#5c9dff'];
 
@@ -86,7 +97,9 @@
   function size(b) { return Math.max(...b.axes.map(norm)); }
 
   function camera(w, h) {
-    const dist = (radius * 2.7) / state.zoom;
+    // The sphere of every body fits the view with a margin: at a distance
+    // d its half-width seen under the half-angle of 19° is d·sin 19°.
+    const dist = (radius * 1.12) / Math.sin((19 * Math.PI) / 180) / state.zoom;
     const cp = Math.cos(state.pitch);
     const eye = add(centre, mul([cp * Math.cos(state.yaw), cp * Math.sin(state.yaw), Math.sin(state.pitch)], dist));
     const f = unit(sub(centre, eye));
@@ -300,10 +313,11 @@
     for (let t = Math.ceil(T0 / tick) * tick; t <= T1 + 1e-9; t += tick) {
       g.fillText(String(+t.toFixed(6)), X(t), fr.h - 6 * fr.dpr);
     }
-    p.curves.forEach((set, dashed) => set.forEach((c, k) => {
-      g.strokeStyle = agentColor(k, dashed ? 75 : 58, dashed ? 0.8 : 1);
-      g.lineWidth = 1.5 * fr.dpr;
-      g.setLineDash(dashed ? [5 * fr.dpr, 4 * fr.dpr] : []);
+    p.curves.forEach((set, observer) => set.forEach((c, k) => {
+      // The body's curve in the agent's look; its observer's thinner, lighter.
+      g.strokeStyle = agentColor(k, observer ? 80 : 58, observer ? 0.7 : 1);
+      g.lineWidth = (observer ? 1 : 1.5) * fr.dpr;
+      g.setLineDash(agentDash(k).map((x) => x * fr.dpr));
       g.beginPath();
       let pen = false;
       c.forEach((v, i) => {
@@ -468,17 +482,23 @@
       $('warning').hidden = false;
       $('warning').textContent = 'incomplete: ' + (r.incomplete_reason || 'stopped early');
     }
-    const legend = $('legend');
+    // The legend folds away past a dozen agents (it would cover the bodies).
+    const legend = $('legend-list');
+    $('legend').open = agents <= 12;
+    $('legend-count').textContent = agents + ' agents';
     D.bodies.forEach((b, k) => {
       if (k === 0) return;
       const row = document.createElement('div');
       const sw = document.createElement('i');
-      sw.style.background = agentColor(k - 1, 58);
+      const colour = agentColor(k - 1, 58);
+      const [on, off] = agentDash(k - 1).length ? agentDash(k - 1) : [1, 0];
+      sw.style.background = 'repeating-linear-gradient(90deg, ' + colour + ' 0 ' + on + 'px, transparent ' + on +
+        'px ' + (on + off) + 'px)';
       row.append(sw, 'agent ' + b.id + (b.leader_link ? ' ◎' : ''));
       legend.append(row);
     });
     $('plot-note').textContent = D.observer
-      ? 'solid: the body (Rᵢ, ωᵢ); dashed: its observer (R̂ᵢ, ω̂ᵢ), drawn in 3D as a dashed ghost'
+      ? 'thick: the body (Rᵢ, ωᵢ); thin, lighter: its observer (R̂ᵢ, ω̂ᵢ), drawn in 3D as a dashed ghost'
       : 'observerless scheme: no estimates';
     if (!D.observer) $('ghosts').parentElement.hidden = true;
   }

@@ -98,7 +98,7 @@ impl Quantity {
 }
 
 /// What the leader's draws replace.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LeaderDispersion {
     /// Nothing: the leader as in the scenario.
@@ -109,8 +109,9 @@ pub enum LeaderDispersion {
     State,
 }
 
-/// The resolved `[monte_carlo]`: what each trial draws and replaces.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// The resolved `[monte_carlo]`: what each trial draws and replaces (read
+/// back from `mc.json` by `attsync mc merge`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Dispersion {
     /// The agents' values replaced by draws (sorted).
     pub disperse: Vec<Quantity>,

@@ -71,7 +71,7 @@ pub enum Distribution {
 }
 
 /// A field's law, checked.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "distribution", rename_all = "kebab-case")]
 pub enum Law {
     /// Uniform on `[min, max]`.
@@ -114,7 +114,7 @@ impl Law {
 }
 
 /// A field drawn per trial.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Dispersed {
     /// The field, as for `--set`.
     pub field: String,

@@ -1,7 +1,8 @@
-//! `attsync mc`: a Monte Carlo over initial conditions, or one of its
-//! trials alone (`--trial K`).
+//! `attsync mc`: a Monte Carlo over initial conditions, one slice of its
+//! trials (`--shard K/N`), one of its trials alone (`--trial K`), or its
+//! slices merged (`attsync mc merge`).
 
-use super::{ScenarioArgs, UntilArgs, WaitArg};
+use super::{ScenarioArgs, SetArgs, UntilArgs, WaitArg};
 use attsync::Error;
 use attsync::interrupt::Interrupt;
 use attsync::mc::{self, McOptions, report};
@@ -13,11 +14,19 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// `attsync mc SCENARIO --trials N [--seed S] [--jobs J] [--engine E]
-/// [--tolerance E] [--out DIR] [--set K=V]… [--trial K]`.
+/// [--tolerance E] [--out DIR] [--set K=V]… [--trial K | --shard K/N]`, or
+/// `attsync mc merge DIR… --out DIR`.
 #[derive(Debug, clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct Mc {
+    /// `merge`: the shards' directories joined.
+    #[command(subcommand)]
+    pub action: Option<Action>,
+    /// Scenario file (TOML).
+    #[arg(required = true)]
+    pub scenario: Option<PathBuf>,
     #[command(flatten)]
-    pub scenario: ScenarioArgs,
+    pub overrides: SetArgs,
     /// Number of trials.
     #[arg(long, required_unless_present = "trial")]
     pub trials: Option<u64>,
@@ -25,8 +34,13 @@ pub struct Mc {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Run only trial K (0-based), as a normal run into --out [default: results/<scenario name>-mc-trial-K], and print the `attsync run` line that reproduces it.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", conflicts_with = "shard")]
     pub trial: Option<u64>,
+    /// Run only slice K of N of the trials (⌊(K−1)·T/N⌋ up to ⌊K·T/N⌋, each
+    /// trial as in the whole run), for a job array; `attsync mc merge` joins
+    /// the slices' directories into the files of one run.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<mc::Shard>,
     /// Trials at once [default: in-process, the number of cores; processes, as many trials as fit the cores (nodes × trials ≤ cores), at least 1].
     #[arg(long)]
     pub jobs: Option<usize>,
@@ -46,7 +60,8 @@ pub struct Mc {
     pub tolerance: f64,
     #[command(flatten)]
     pub until: UntilArgs,
-    /// Results directory [default: results/<scenario name>-mc].
+    /// Results directory [default: results/<scenario name>-mc; a shard's,
+    /// results/<scenario name>-shard-K-of-N-mc].
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// No progress bar.
@@ -58,10 +73,36 @@ pub struct Mc {
     pub no_stiffness_check: bool,
 }
 
-/// Runs the Monte Carlo (or one trial) and prints its table.
+/// `attsync mc merge`.
+#[derive(Debug, clap::Subcommand)]
+pub enum Action {
+    /// Join the directories of `attsync mc --shard K/N` (every K of one N)
+    /// into the files one run of every trial writes, byte for byte.
+    Merge(Merge),
+}
+
+/// `attsync mc merge DIR… --out DIR`.
+#[derive(Debug, clap::Args)]
+pub struct Merge {
+    /// The shards' results directories (any order).
+    #[arg(required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// Results directory of the whole Monte Carlo.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// Runs the Monte Carlo (one trial, one shard, or the merge) and prints its table.
 pub fn exec(a: Mc, interrupt: &Interrupt) -> Result<(), Error> {
+    if let Some(Action::Merge(m)) = a.action {
+        return merge(&m);
+    }
     let check = StiffnessCheck::from_flag(a.no_stiffness_check);
-    let loaded = a.scenario.load(check)?;
+    let scenario = ScenarioArgs {
+        scenario: a.scenario.clone().expect("clap requires SCENARIO"),
+        overrides: a.overrides.clone(),
+    };
+    let loaded = scenario.load(check)?;
     for w in &loaded.resolved.warnings {
         eprintln!("warning: {}: {w}", loaded.file.display());
     }
@@ -70,8 +111,8 @@ pub fn exec(a: Mc, interrupt: &Interrupt) -> Result<(), Error> {
         .jobs
         .unwrap_or_else(|| sweep::default_jobs(a.engine, nodes, sweep::cores()));
     let o = McOptions {
-        scenario: a.scenario.scenario.clone(),
-        set: a.scenario.overrides.set.clone(),
+        scenario: scenario.scenario.clone(),
+        set: scenario.overrides.set.clone(),
         trials: a.trials.unwrap_or(1),
         seed: a.seed,
         jobs,
@@ -86,10 +127,19 @@ pub fn exec(a: Mc, interrupt: &Interrupt) -> Result<(), Error> {
             a.until
                 .judging(a.tolerance, net.steps as f64 * net.dt, false)
         },
-        out: (a.out.clone()).unwrap_or_else(|| mc::options::default_out(&loaded.name())),
+        out: (a.out.clone()).unwrap_or_else(|| match a.shard {
+            None => mc::options::default_out(&loaded.name()),
+            Some(s) => mc::options::default_out(&format!(
+                "{}-shard-{}-of-{}",
+                loaded.name(),
+                s.index,
+                s.count
+            )),
+        }),
         progress: !a.quiet && std::io::stderr().is_terminal(),
         stiffness: check,
         law: None,
+        shard: a.shard,
     };
     match a.trial {
         Some(k) => alone(&o, k, a.out.is_none().then(|| loaded.name()), interrupt),
@@ -97,8 +147,23 @@ pub fn exec(a: Mc, interrupt: &Interrupt) -> Result<(), Error> {
     }
 }
 
+fn merge(m: &Merge) -> Result<(), Error> {
+    let r = mc::merge(&m.dirs, &m.out)?;
+    print!("{}", report::table(&r.summary, &r.results));
+    println!("{} shards merged", m.dirs.len());
+    println!("results: {}", m.out.display());
+    Ok(())
+}
+
 fn many(o: &McOptions, interrupt: &Interrupt) -> Result<(), Error> {
     let r = mc::monte_carlo(o, interrupt)?;
+    if let Some(shard) = o.shard {
+        let trials = o.range();
+        println!(
+            "shard {shard}: trials {}..{} of {}",
+            trials.start, trials.end, o.trials
+        );
+    }
     print!("{}", report::table(&r.summary, &r.results));
     let n = r.results.len() as f64;
     println!(
