@@ -27,6 +27,8 @@
 //! - [`view`]: `view.html`, a run in 3D in the browser (one self-contained file).
 //! - `export` (feature `mcap`, on by default): a run's `states.bin` as an MCAP
 //!   recording for Foxglove, Lichtblick and Rerun.
+//! - `tables` (feature `parquet`, on by default): a run's errors, states and
+//!   leader as Parquet tables.
 //!
 //! The binary (`src/bin/attsync/`) only parses the command line and calls
 //! these; one file per subcommand in `commands/`.
@@ -54,6 +56,8 @@ pub mod results;
 pub mod run;
 pub use ::scenario;
 pub mod sweep;
+#[cfg(feature = "parquet")]
+pub mod tables;
 pub use ::bridge::trust;
 pub mod until;
 pub mod verify;

@@ -261,7 +261,7 @@ class Run:
         ``attsync export --csv`` for agents)."""
         s = self.states
         T, n = s.R.shape[:2]
-        cols = {"t": s.t.repeat(n), "agent": np.tile(s.agent_ids, T)}
+        cols = {"t": s.t.repeat(n), "agent": np.tile(s.agent_ids.astype(np.int64), T)}
         parts = [("r", s.R), ("w", s.omega), ("r_hat", s.R_hat), ("w_hat", s.omega_hat),
                  ("s_hat", s.sigma_hat), ("tau", s.tau)]
         for name, x in parts:

@@ -33,7 +33,7 @@ fn assemble(dir: &Path) {
 #[test]
 fn the_python_packages_tests_pass() {
     require_python_modules(
-        "numpy, pandas, pyarrow, pytest, matplotlib, dask, distributed",
+        "numpy, pandas, pyarrow, pytest, matplotlib, dask, distributed, nbclient, nbformat, ipykernel",
         "tools/test-deps.sh (or `python3 -m pip install -r python/requirements.txt`)",
     );
     let tmp = Sandbox::new("python_package");

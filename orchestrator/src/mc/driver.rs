@@ -228,7 +228,7 @@ fn initial_csv(base: &Base, results: &[TrialResult]) -> String {
 }
 
 /// What a Monte Carlo's directory holds besides `mc.json`, made ready
-/// (by a run or by [`super::merge`]).
+/// (by a run or by [`mod@super::merge`]).
 pub(super) struct Files {
     /// `trials.csv`'s header.
     pub header: String,

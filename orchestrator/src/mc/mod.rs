@@ -18,7 +18,7 @@
 //! - [`stats`]: exact binomial (Clopper–Pearson) bounds.
 //! - [`report`]: `trials.csv`, `initial.csv`, `mc.json`, the stdout table.
 //! - `plot`: `mc.svg`.
-//! - [`shard`]: `--shard K/N`, a slice of the trials; [`merge`]: `attsync
+//! - [`shard`]: `--shard K/N`, a slice of the trials; [`mod@merge`]: `attsync
 //!   mc merge`, the slices joined into one run's files.
 //! - [`options`], `error`, `driver`: [`McOptions`], [`McError`], and
 //!   [`monte_carlo`] / [`trial_alone`] (the work queue, the files).

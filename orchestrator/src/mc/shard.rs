@@ -1,7 +1,7 @@
 //! `--shard K/N`: one of `N` slices of a Monte Carlo's trials, so that a
 //! job array (Slurm, GNU parallel, a Dask cluster) spreads one Monte Carlo
 //! over many machines; `attsync mc merge` joins the slices' directories
-//! into the files one run would have written ([`super::merge`]).
+//! into the files one run would have written ([`mod@super::merge`]).
 //!
 //! Shard `K` of `N` runs the trials `⌊(K−1)·T/N⌋ .. ⌊K·T/N⌋` of `T`: the
 //! slices are contiguous, disjoint, cover every trial and differ in size

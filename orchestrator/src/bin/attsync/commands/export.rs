@@ -1,16 +1,18 @@
-//! `attsync export`: a run's states.bin as CSV, or as an MCAP recording.
+//! `attsync export`: a run's states.bin as CSV, as an MCAP recording, or
+//! the run's tables as Parquet.
 
 use attsync::Error;
 use std::path::{Path, PathBuf};
 
-/// `attsync export DIR/states.bin (--csv | --mcap) [--out FILE]`.
+/// `attsync export DIR[/states.bin] (--csv | --mcap | --parquet) [--out PATH]`.
 #[derive(Debug, clap::Args)]
 pub struct Export {
-    /// The states.bin file of a run.
+    /// A run's results directory, or its states.bin.
     pub states: PathBuf,
     #[command(flatten)]
     pub format: Format,
-    /// Write here instead of stdout (--csv) or DIR/states.mcap (--mcap).
+    /// Write here instead of stdout (--csv), DIR/states.mcap (--mcap) or
+    /// into DIR (--parquet: a directory).
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
@@ -27,10 +29,28 @@ pub struct Format {
     /// and Rerun; default --out DIR/states.mcap.
     #[arg(long)]
     pub mcap: bool,
+    /// Write errors.parquet, states.parquet (one row per agent per sample,
+    /// torques included) and leader.parquet: tables pandas, polars and
+    /// DuckDB read as they are; default --out DIR.
+    #[arg(long)]
+    pub parquet: bool,
 }
 
-/// Writes the CSV or the recording.
-pub fn exec(a: Export) -> Result<(), Error> {
+/// Writes the CSV, the recording or the tables.
+pub fn exec(mut a: Export) -> Result<(), Error> {
+    if a.states.is_dir() {
+        a.states = a.states.join(attsync::results::layout::STATES);
+    }
+    if a.format.parquet {
+        if !a.states.is_file() {
+            return Err(Error::Export(format!(
+                "{}: no states.bin there (give a run's results directory or its states.bin)",
+                a.states.display()
+            )));
+        }
+        let dir = a.states.parent().unwrap_or(Path::new("")).to_owned();
+        return parquet(&dir, a.out.as_deref().unwrap_or(&dir));
+    }
     if a.format.mcap {
         let out = a.out.unwrap_or_else(|| default_mcap(&a.states));
         return mcap(&a.states, &out);
@@ -66,6 +86,26 @@ fn mcap(states: &Path, out: &Path) -> Result<(), Error> {
 fn mcap(_: &Path, out: &Path) -> Result<(), Error> {
     Err(Error::Export(format!(
         "{}: this attsync was built without the cargo feature `mcap`",
+        out.display()
+    )))
+}
+
+/// Writes the run's tables in `dir` into `out` and says what it wrote.
+#[cfg(feature = "parquet")]
+fn parquet(dir: &Path, out: &Path) -> Result<(), Error> {
+    let w = attsync::tables::write_parquet(dir, out).map_err(|e| Error::Export(e.to_string()))?;
+    for f in &w.files {
+        println!("wrote {}", f.display());
+    }
+    println!("{} rows of agent states", w.state_rows);
+    Ok(())
+}
+
+/// Without the `parquet` feature there are no tables.
+#[cfg(not(feature = "parquet"))]
+fn parquet(_: &Path, out: &Path) -> Result<(), Error> {
+    Err(Error::Export(format!(
+        "{}: this attsync was built without the cargo feature `parquet`",
         out.display()
     )))
 }
