@@ -70,6 +70,18 @@ impl Stepper for AgentNode {
         }
     }
 
+    fn lookahead(&self, k: usize) -> u64 {
+        self.agent.lookahead(k)
+    }
+
+    fn receive_stamped(&mut self, k: usize, x: Exchanged, stamp: (u64, u32)) {
+        if k < self.agent.model().neighbours.len() {
+            self.agent.receive_neighbour_stamped(k, x, true, stamp);
+        } else {
+            self.agent.receive_leader_stamped(x, true, stamp);
+        }
+    }
+
     fn advance(&mut self) {
         self.agent.advance();
     }

@@ -672,7 +672,38 @@ impl Agent {
     /// already evaluated (once per sender, by an engine that hands one
     /// value to many receivers).
     pub fn receive_neighbour_judged(&mut self, k: usize, x: Exchanged, trusted: bool) {
-        self.hold_neighbour(k, &x, trusted);
+        let now = (self.n, self.step.stage() as u32);
+        self.hold_neighbour(k, &x, trusted, now);
+    }
+
+    /// [`Self::receive_neighbour_judged`] of a message stamped `stamp`
+    /// taken before its receiver's slot (lookahead, [`Self::lookahead`]):
+    /// the link places it by its stamp, so the result is the one of taking
+    /// it at that slot (PROTOCOL.md § 10.9).
+    pub fn receive_neighbour_stamped(
+        &mut self,
+        k: usize,
+        x: Exchanged,
+        trusted: bool,
+        stamp: (u64, u32),
+    ) {
+        self.hold_neighbour(k, &x, trusted, stamp);
+    }
+
+    /// How many steps ahead of its receiver the `k`-th input (the leader
+    /// after the neighbours) may be taken: its link's delay, whose values
+    /// are used that many steps after they are sent (eq. `districontrol`
+    /// with `Rⱼ(t − τ)`); 0 for an undelayed input, and for every input of
+    /// an agent with a timeline (a crash, an outage or a retune is decided
+    /// at the receiver's own slot).
+    #[must_use]
+    pub fn lookahead(&self, k: usize) -> u64 {
+        if self.model.timeline.is_some() {
+            return 0;
+        }
+        (self.links.get(k))
+            .and_then(|l| l.as_deref())
+            .map_or(0, Link::delay)
     }
 
     /// What an engine that keeps the neighbours' values itself (the
@@ -698,8 +729,8 @@ impl Agent {
     }
 
     /// [`Self::receive_neighbour_judged`] from where the value lies (one
-    /// copy, into the held value).
-    fn hold_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool) {
+    /// copy, into the held value), of a message stamped `(m, s)`.
+    fn hold_neighbour(&mut self, k: usize, x: &Exchanged, trusted: bool, (m, s): (u64, u32)) {
         if self.is_down() {
             return;
         }
@@ -708,7 +739,7 @@ impl Agent {
             return;
         }
         match &mut self.links[k] {
-            Some(link) => link.offer(self.n, self.step.stage() as u32, *x),
+            Some(link) => link.offer(m, s, *x),
             None => self.held_nbrs[k] = *x,
         }
     }
@@ -723,6 +754,13 @@ impl Agent {
     /// [`Self::receive_leader`] with `trusted = x.trust().is_ok()` already
     /// evaluated (see [`Self::receive_neighbour_judged`]).
     pub fn receive_leader_judged(&mut self, x: Exchanged, trusted: bool) {
+        let now = (self.n, self.step.stage() as u32);
+        self.receive_leader_stamped(x, trusted, now);
+    }
+
+    /// [`Self::receive_leader_judged`] of a message stamped `(m, s)` (see
+    /// [`Self::receive_neighbour_stamped`]).
+    pub fn receive_leader_stamped(&mut self, x: Exchanged, trusted: bool, (m, s): (u64, u32)) {
         let k = self.model.neighbours.len();
         if self.is_down() {
             return;
@@ -731,9 +769,8 @@ impl Agent {
             self.rejected[k] += 1;
             return;
         }
-        let stage = self.step.stage() as u32;
         match (&mut self.held_leader, self.links.get_mut(k)) {
-            (Some(_), Some(Some(link))) => link.offer(self.n, stage, x),
+            (Some(_), Some(Some(link))) => link.offer(m, s, x),
             (Some(h), _) => **h = x,
             (None, _) => {}
         }

@@ -190,6 +190,12 @@ impl Link {
         }
     }
 
+    /// The link's delay, steps.
+    #[must_use]
+    pub fn delay(&self) -> u64 {
+        self.model.delay
+    }
+
     /// Offers the sender's message stamped `(m, s)`.
     pub fn offer(&mut self, m: u64, s: u32, x: Exchanged) {
         if self.held.is_none() {

@@ -80,6 +80,15 @@ impl Daemon {
         }
     }
 
+    /// What it printed on its stdout so far (empty before it started).
+    #[must_use]
+    pub fn stdout(&self) -> String {
+        self.process
+            .as_ref()
+            .map(HostProcess::stdout)
+            .unwrap_or_default()
+    }
+
     /// Whether it runs without authentication (`--insecure`, `tcp/`).
     #[must_use]
     pub fn insecure(&self) -> bool {

@@ -99,3 +99,38 @@ fn a_run_request_larger_than_a_zenoh_batch_arrives_whole() {
     parity(&tmp, &tree, &["simulation.duration=0.1"], &hosts);
     assert_hosts_clean(&[&a]);
 }
+
+#[test]
+fn delayed_cut_links_are_taken_ahead_and_stay_byte_identical() {
+    // Lookahead (issue 37): a link delayed by k steps lets its receiver
+    // wait only for the sender's state of k steps ago, so the sides run
+    // ahead of each other; the results stay the lockstep ones. k = 1 and 4
+    // (dt = 1 ms), and a mixed graph: k = 4 on most links, 1 on the
+    // leader's link to agent 1, none from agent 3 to agent 1.
+    let tmp = Sandbox::new("hosts-lookahead");
+    let a = Daemon::start("a", &[]);
+    let hosts = hosts_file(tmp.path(), "hosts.toml", &[(&a, true, &[2, 4, 6])]);
+    let observerless = paper("constant-observerless");
+    let mixed = tmp.join("mixed.toml");
+    let text = std::fs::read_to_string(&observerless).expect("the paper's scenario");
+    let links = "\n[network]\ndelay = 0.004\n\
+                 [[network.link]]\nfrom = 0\nto = 1\ndelay = 0.001\n\
+                 [[network.link]]\nfrom = 3\nto = 1\ndelay = 0.0\n";
+    std::fs::write(&mixed, text + links).expect("write");
+    let runs: [(&str, &Path, &str); 3] = [
+        ("k1", &observerless, "network.delay=0.001"),
+        ("k4", &observerless, "network.delay=0.004"),
+        ("mixed", &mixed, "network.seed=1"),
+    ];
+    for (name, scenario, delay) in runs {
+        let sets = ["simulation.duration=1", delay];
+        let (p, i) = (tmp.join(format!("{name}-hosts")), tmp.join(name));
+        run_on_hosts(tmp.path(), scenario, &p, &sets, &hosts)
+            .output()
+            .assert_ok()
+            .assert_no_leftovers();
+        reference_run(tmp.path(), scenario, &i, &sets);
+        assert_same_results(&p, &i);
+    }
+    assert_hosts_clean(&[&a]);
+}

@@ -42,6 +42,22 @@ fn timevarying_with_agents_on_one_host_is_byte_identical() {
     let log = std::fs::read_to_string(p.join("logs/agent-2.log")).expect("agent-2's log");
     assert!(log.contains("done"), "{log}");
     assert_hosts_clean(&[&a]);
+    // The daemon said that it listens (name, endpoint, version), then one
+    // line for the run it served.
+    let said = a.stdout();
+    let lines: Vec<&str> = said.lines().collect();
+    let version = env!("CARGO_PKG_VERSION");
+    assert!(
+        lines[0].starts_with(&format!(
+            "attsync host a {version}: listening on quic/127.0.0.1:"
+        )),
+        "{said}"
+    );
+    assert!(
+        lines[1].starts_with("run ") && lines[1].ends_with(": started 2 nodes (agent-2, agent-3)"),
+        "{said}"
+    );
+    assert_eq!(lines.len(), 2, "{said}");
 }
 
 #[test]

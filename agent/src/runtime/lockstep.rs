@@ -1,9 +1,11 @@
 //! Deterministic lockstep: the node walks the run's [`Schedule`]; at every
 //! exchange (n, s) it publishes its stage state stamped (n, s), wakes its
 //! receivers, waits (bounded) until every input's message stamped (n, s)
-//! has arrived, then advances one stage.
+//! has arrived, then advances one stage. An input on a link delayed by d
+//! steps is waited for only up to (n − d, s) (`lookahead.rs`).
 
 use super::hooks::{Hooked, Hooks};
+use super::lookahead::{self, Ahead, Stamp, Taking};
 use super::{
     Inputs, NodeError, Orphan, Stepper, after_stage_0, after_step, before_step, check_origin,
     crash_point,
@@ -30,7 +32,8 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
     if first == 0 {
         io.report(stepper.sample(0))?;
     }
-    let mut held = Held::new(cfg);
+    let mut held = Held::new(cfg, stepper);
+    let mut last: Option<Stamp> = None;
     let slots = Schedule::new(cfg.coupling, cfg.steps).slots();
     for slot in slots.skip_while(|s| s.step < first) {
         if slot.starts_step() {
@@ -44,6 +47,7 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
         } else if slot.exchange {
             let take = (&mut *inputs, &mut held);
             exchange(io, cfg, stepper, take, &mut waiter, slot, orphan)?;
+            last = Some((slot.step, slot.stage));
         }
         stepper.advance();
         if slot.starts_step() {
@@ -53,7 +57,40 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
             after_step(io, cfg, stepper, slot.step + 1)?;
         }
     }
+    if let Some(end) = last.filter(|_| held.ahead.any()) {
+        drain(
+            io,
+            cfg,
+            stepper,
+            (inputs, &mut held),
+            &mut waiter,
+            end,
+            orphan,
+        )?;
+    }
     Ok(Pacing::default())
+}
+
+/// Takes what the delayed inputs sent up to the last exchange `end`
+/// (nothing of it is used any more, but the links count it as lockstep does).
+fn drain<S: Service, N: Stepper, H: Hooks>(
+    io: &mut Hooked<'_, S, H>,
+    cfg: &NodeConfig,
+    stepper: &mut N,
+    (inputs, held): (&mut Inputs, &mut Held),
+    waiter: &mut Waiter,
+    end: Stamp,
+    orphan: &Orphan,
+) -> Result<(), NodeError> {
+    let deadline = Instant::now() + Duration::from_secs_f64(cfg.stage_timeout);
+    waiter.begin();
+    for k in 0..cfg.inputs.len() {
+        if held.ahead.delay[k] > 0 {
+            let node = (&mut *io, cfg, &mut *stepper, &mut *inputs);
+            held.take_ahead(node, (&mut *waiter, orphan), k, (end, Some(end)), deadline)?;
+        }
+    }
+    Ok(())
 }
 
 /// What a new process of a crashed agent took from an input before it
@@ -66,14 +103,39 @@ struct Held {
     /// Whether this process took over from a crashed one (then messages
     /// older than the exchange due are leftovers of the time it was down).
     resumed: bool,
+    /// The delayed inputs, taken ahead.
+    ahead: Ahead,
 }
 
 impl Held {
-    fn new(cfg: &NodeConfig) -> Self {
+    fn new<N: Stepper>(cfg: &NodeConfig, stepper: &N) -> Self {
         Self {
             next: vec![None; cfg.inputs.len()],
             resumed: cfg.resume.is_some(),
+            ahead: Ahead::new(cfg, stepper),
         }
+    }
+
+    /// Takes delayed input `k`'s messages in `window` (the node's slot,
+    /// the stamp due: [`lookahead::take`]).
+    fn take_ahead<S: Service, N: Stepper, H: Hooks>(
+        &mut self,
+        (io, cfg, stepper, inputs): (&mut Hooked<'_, S, H>, &NodeConfig, &mut N, &mut Inputs),
+        (waiter, orphan): (&mut Waiter, &Orphan),
+        k: usize,
+        window: (Stamp, Option<Stamp>),
+        deadline: Instant,
+    ) -> Result<(), NodeError> {
+        let mut t = Taking {
+            io,
+            cfg,
+            stepper,
+            inputs,
+            next: &mut self.next,
+            waiter,
+            orphan,
+        };
+        lookahead::take(&mut t, &mut self.ahead, k, window, deadline)
     }
 
     /// Input `k`'s next message, the one kept first.
@@ -157,7 +219,15 @@ fn exchange<S: Service, N: Stepper, H: Hooks>(
     io.publish(slot, msg, waiter.receivers_may_block())?;
     let deadline = Instant::now() + Duration::from_secs_f64(cfg.stage_timeout);
     waiter.begin();
+    held.ahead.reached((n, s));
     for k in 0..cfg.inputs.len() {
+        let d = held.ahead.delay[k];
+        if d > 0 {
+            let window = ((n, s), lookahead::due(d, (n, s)));
+            let node = (&mut *io, cfg, &mut *stepper, &mut *inputs);
+            held.take_ahead(node, (&mut *waiter, orphan), k, window, deadline)?;
+            continue;
+        }
         let msg = loop {
             // Take one message at a time: what stays in iceoryx2's
             // buffer holds a fast sender back (flow control).
@@ -194,5 +264,6 @@ fn exchange<S: Service, N: Stepper, H: Hooks>(
             stepper.receive(k, x);
         }
     }
+    held.ahead.trim();
     Ok(())
 }

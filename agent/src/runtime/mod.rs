@@ -26,6 +26,7 @@
 
 mod hooks;
 mod lockstep;
+mod lookahead;
 mod ports;
 mod realtime;
 
@@ -93,6 +94,22 @@ pub trait Stepper {
     /// nobody uses and takes nothing from its inputs.
     fn is_down(&self) -> bool {
         false
+    }
+    /// How many steps ahead of the node input `k` may be taken (its link's
+    /// delay: PROTOCOL.md § 10.9): at exchange (n, s) the loop waits only
+    /// for that input's messages up to (n − d, s), and hands every message
+    /// up to (n, s) to [`Stepper::receive_stamped`]. 0 (the default): the
+    /// input is taken in lockstep, through [`Stepper::receive`].
+    fn lookahead(&self, k: usize) -> u64 {
+        let _ = k;
+        0
+    }
+    /// [`Stepper::receive`] of a message stamped `stamp` (step, stage),
+    /// taken at or before the node's own slot (an input with a
+    /// [`Stepper::lookahead`]).
+    fn receive_stamped(&mut self, k: usize, x: Exchanged, stamp: (u64, u32)) {
+        let _ = stamp;
+        self.receive(k, x);
     }
 }
 

@@ -8,6 +8,7 @@
 
 use super::host_run::{self, Command};
 use super::keys;
+use super::report::{DaemonEvent, Report};
 use super::wire::{Answer, EndRequest, RunOffer};
 use super::zconfig::{self, ConfigError};
 use crate::trust::Security;
@@ -104,8 +105,9 @@ pub fn ping_text(name: &str) -> String {
     format!("attsync host {name} {}", env!("CARGO_PKG_VERSION"))
 }
 
-/// Serves until `stop` is set.
-pub fn serve(opts: &HostOptions, stop: &AtomicBool) -> Result<(), HostError> {
+/// Serves until `stop` is set, telling `report` that it listens and each
+/// run it starts or refuses.
+pub fn serve(opts: &HostOptions, stop: &AtomicBool, report: Report) -> Result<(), HostError> {
     opts.check()?;
     let session = zconfig::open(&opts.listen, &opts.connect, &opts.security)?;
     let name = opts.name.clone();
@@ -131,10 +133,15 @@ pub fn serve(opts: &HostOptions, stop: &AtomicBool) -> Result<(), HostError> {
     let allowed: Vec<_> = opts.allow.programs().iter().map(|p| p.display()).collect();
     tracing::info!(host = %name, listen = ?opts.listen, connect = ?opts.connect,
         security = opts.security.name(), plugins = ?allowed, "serving");
+    report(DaemonEvent::Listening {
+        name: name.clone(),
+        listen: opts.listen.clone(),
+        connect: opts.connect.clone(),
+    });
     let mut runs: HashMap<String, (Sender<Command>, JoinHandle<()>)> = HashMap::new();
     while !stop.load(Ordering::Relaxed) {
         if let Ok(Some(q)) = run_q.recv_timeout(Duration::from_millis(50)) {
-            accept(&session, (&name, &opts.allow), q, &mut runs);
+            accept(&session, (&name, &opts.allow, &report), q, &mut runs);
         }
         while let Ok(Some(q)) = end_q.try_recv() {
             route_end(q, &runs);
@@ -168,7 +175,7 @@ fn refuse(q: &Query, why: String) {
 /// ([`host_run::serve_offer`]).
 fn accept(
     session: &zenoh::Session,
-    (name, allow): (&str, &Allowlist),
+    (name, allow, report): (&str, &Allowlist, &Report),
     q: Query,
     runs: &mut HashMap<String, (Sender<Command>, JoinHandle<()>)>,
 ) {
@@ -185,8 +192,8 @@ fn accept(
     let (tx, rx) = mpsc::channel();
     let s = session.clone();
     let run = req.run.clone();
-    let allow = allow.clone();
-    let t = std::thread::spawn(move || host_run::serve_offer(s, req, q, rx, &allow));
+    let (allow, report) = (allow.clone(), report.clone());
+    let t = std::thread::spawn(move || host_run::serve_offer(s, req, q, rx, (&allow, &report)));
     runs.insert(run, (tx, t));
 }
 

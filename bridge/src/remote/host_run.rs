@@ -11,6 +11,7 @@ pub use super::host_run_error::{RequestError, StartError};
 use super::keys;
 use super::local::{LocalNs, Shared};
 use super::pieces;
+use super::report::{DaemonEvent, Report};
 use super::telemetry::{self, End, TelemetryThread};
 use super::wire::{Answer, EndReply, EndRequest, HostEvent, NodeEnd, RunOffer, RunRequest};
 use crate::trust::allow::{Allowlist, Asked};
@@ -144,12 +145,16 @@ pub fn serve_offer(
     offer: RunOffer,
     reply: Query,
     commands: Receiver<Command>,
-    allow: &Allowlist,
+    (allow, report): (&Allowlist, &Report),
 ) {
     match fetch(&session, &offer).and_then(|r| admit(r, allow)) {
-        Ok(req) => serve(session, req, reply, commands),
+        Ok(req) => serve(session, req, reply, (commands, report)),
         Err(e) => {
             tracing::warn!(run = %offer.run, "refused: {e}");
+            report(DaemonEvent::Refused {
+                run: offer.run.clone(),
+                why: e.to_string(),
+            });
             answer(&reply, &Answer::Err(e.to_string()));
         }
     }
@@ -234,7 +239,12 @@ fn check_node(n: &super::wire::RemoteNode) -> Result<(), RequestError> {
 }
 
 /// Serves run `req` until it ends; `reply` gets the answer to the run request.
-pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: Receiver<Command>) {
+pub fn serve(
+    session: zenoh::Session,
+    req: RunRequest,
+    reply: Query,
+    (commands, report): (Receiver<Command>, &Report),
+) {
     let shared = Shared::default();
     // Declared before the answer, so that no command of the run is missed.
     let Some(ports) = RunPorts::declare(&session, &req) else {
@@ -246,10 +256,18 @@ pub fn serve(session: zenoh::Session, req: RunRequest, reply: Query, commands: R
         Ok(x) => x,
         Err(e) => {
             tracing::warn!(run = %req.run, "cannot start the run: {e}");
+            report(DaemonEvent::Refused {
+                run: req.run.clone(),
+                why: e.to_string(),
+            });
             answer(&reply, &Answer::Err(e.to_string()));
             return;
         }
     };
+    report(DaemonEvent::Started {
+        run: req.run.clone(),
+        nodes: req.nodes.iter().map(|n| n.name.clone()).collect(),
+    });
     answer(&reply, &Answer::Ok(()));
     drop(reply); // its final reply: the orchestrator's query completes
     tracing::info!(run = %req.run, nodes = nodes.len(), "run started");

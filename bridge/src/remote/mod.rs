@@ -15,7 +15,8 @@
 //! - [`bridge`], [`telemetry`]: the threads that carry states and telemetry.
 //! - [`plan`]: which host runs which node; the state links between sides.
 //! - [`client`]: the orchestrator's side ([`Remote`]; its errors [`RemoteError`]).
-//! - [`daemon`], [`host_run`]: the host's side.
+//! - [`daemon`], [`host_run`]: the host's side; [`report`]: what it says
+//!   on its stdout.
 
 pub mod bridge;
 mod bridge_error;
@@ -29,6 +30,7 @@ pub mod link;
 pub mod local;
 pub mod pieces;
 pub mod plan;
+pub mod report;
 pub mod telemetry;
 pub mod wire;
 pub mod zconfig;

@@ -73,7 +73,14 @@ pub fn exec(a: Host, interrupt: &Interrupt) -> Result<(), Error> {
         eprintln!("attsync host: warning: {INSECURE_WARNING}");
     }
     interrupt.arm();
-    daemon::serve(&opts, interrupt.flag())?;
+    // One line when it listens, one per run it starts or refuses.
+    let print = |e: attsync::remote::report::DaemonEvent| {
+        use std::io::Write;
+        let mut out = std::io::stdout().lock();
+        let _ = writeln!(out, "{e}");
+        let _ = out.flush();
+    };
+    daemon::serve(&opts, interrupt.flag(), std::sync::Arc::new(print))?;
     Ok(())
 }
 
