@@ -184,13 +184,7 @@ fn converging_trials_are_counted_with_their_bound() {
 fn a_diverging_trial_is_classified_as_diverged() {
     let tmp = tempfile::tempdir().unwrap();
     // dt far beyond RK4's stable step: the integration blows up.
-    let sets = [
-        "--no-stiffness-check",
-        "--set",
-        "simulation.dt=0.5",
-        "--set",
-        "output.sample_period=0.5",
-    ];
+    let sets = common::DIVERGING;
     let out = mc(tmp.path(), &paper("constant-observerless"), 2, "mc", &sets);
     out.assert_code(0);
     for r in trials(&tmp.path().join("mc")) {

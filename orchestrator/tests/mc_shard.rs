@@ -108,13 +108,7 @@ fn diverged_trials_keep_their_reasons_when_merged() {
     let file = Path::new(&file);
     // dt far beyond RK4's stable step: every trial diverges, with a reason
     // that only mc.json's `slowest` holds.
-    let sets = [
-        "--no-stiffness-check",
-        "--set",
-        "simulation.dt=0.5",
-        "--set",
-        "output.sample_period=0.5",
-    ];
+    let sets = common::DIVERGING;
     mc(tmp.path(), file, 5, "whole", &sets).assert_code(0);
     for k in 1..=2 {
         let mut extra = sets.to_vec();

@@ -32,6 +32,17 @@ pub const OBSERVERLESS: &str = concat!(
     "/../scenarios/paper/constant-observerless.toml"
 );
 
+/// Flags that make every run diverge: a `simulation.dt` far beyond RK4's
+/// stable step (the integration blows up), allowed by
+/// `--no-stiffness-check`, sampled at that step.
+pub const DIVERGING: [&str; 5] = [
+    "--no-stiffness-check",
+    "--set",
+    "simulation.dt=0.5",
+    "--set",
+    "output.sample_period=0.5",
+];
+
 /// `scenarios/paper/<name>.toml`: `timevarying`, `constant-observer`,
 /// `constant-observerless`.
 #[must_use]
