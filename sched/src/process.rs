@@ -133,6 +133,14 @@ mod tests {
     fn a_childs_group_command_line_and_threads_are_read() {
         let mut child = Command::new("sleep").arg("30").spawn().expect("sleep");
         let pid = child.id();
+        // `spawn` returns once the child is forked, not once it has exec'd
+        // `sleep`: until then its name is ours and its command line empty.
+        let exec = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        while (thread_name(pid, pid).as_deref() != Some("sleep") || cmdline(pid).is_empty())
+            && std::time::Instant::now() < exec
+        {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
         let group = crate::stat::own().expect("own stat").pgrp;
         let seen = (
             group_members(group).contains(&pid),
