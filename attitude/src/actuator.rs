@@ -28,10 +28,7 @@ impl Saturation {
     #[must_use]
     pub fn apply(&self, tau: &Vector3<f64>) -> Vector3<f64> {
         match *self {
-            Saturation::Norm { max } => {
-                let n = tau.norm();
-                if n > max { tau * (max / n) } else { *tau }
-            }
+            Saturation::Norm { max } => scale_down(tau, max),
             Saturation::Axes { max } => Vector3::new(
                 tau.x.clamp(-max[0], max[0]),
                 tau.y.clamp(-max[1], max[1]),
@@ -68,10 +65,32 @@ impl RateLimit {
         h: f64,
     ) -> Vector3<f64> {
         let step = tau - anchor;
-        let n = step.norm();
         let m = (self.max * h) * SINCE_ANCHOR[s];
+        let n2 = step.norm_squared();
+        if n2 < m * m * WELL_BELOW {
+            return *tau;
+        }
+        let n = n2.sqrt();
         if n > m { anchor + step * (m / n) } else { *tau }
     }
+}
+
+/// A bound on `‖v‖²` below which `‖v‖ ≤ max` needs no square root: the
+/// computed `max·max·WELL_BELOW` is below `max²` whatever its roundings,
+/// so a computed `‖v‖²` under it has `sqrt` at most `max` (`sqrt` is
+/// correctly rounded and `max` a double). Only a shortcut: the result is
+/// the same bits as comparing `norm(v) > max` (§ 10.11); an infinite or
+/// NaN `‖v‖²` fails the strict `<` and takes the long way.
+const WELL_BELOW: f64 = 1.0 - 1e-6;
+
+/// `v · (max / ‖v‖)` when `‖v‖ > max`, else `v`.
+fn scale_down(v: &Vector3<f64>, max: f64) -> Vector3<f64> {
+    let n2 = v.norm_squared();
+    if n2 < max * max * WELL_BELOW {
+        return *v;
+    }
+    let n = n2.sqrt();
+    if n > max { v * (max / n) } else { *v }
 }
 
 #[cfg(test)]
@@ -91,6 +110,60 @@ mod tests {
         };
         assert_eq!(axes.apply(&tau), Vector3::new(1.0, -4.0, 0.0));
         assert_eq!(axes.apply(&-tau), Vector3::new(-1.0, 4.0, 0.0));
+    }
+
+    /// The shortcut gives the bits of the formula of § 10.11, near the
+    /// limit, far from it, and for infinite and NaN torques.
+    #[test]
+    fn the_shortcut_below_the_limit_gives_the_formulas_bits() {
+        let formula = |tau: &Vector3<f64>, max: f64| {
+            let n = tau.norm();
+            if n > max { tau * (max / n) } else { *tau }
+        };
+        let mut rng = crate::random::SplitMix64(5);
+        let mut near = 0;
+        for k in 0..200_000 {
+            let max = [1.0, 0.3, 7.5, 1e-3, 1e200][k % 5];
+            let dir = Vector3::from(rng.normal3()).normalize();
+            let tau = dir * (max * (1.0 + (rng.unit() - 0.5) * 1e-5 * f64::from(k as u32 % 3)));
+            near += usize::from((tau.norm() / max - 1.0).abs() < 1e-6);
+            let got = Saturation::Norm { max }.apply(&tau);
+            let want = formula(&tau, max);
+            assert!(
+                got.iter()
+                    .zip(&want)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
+            // the rate limit: ρ·h·1 = max at stage 0, from an anchor
+            let anchor = Vector3::new(0.25, -0.5, 1.0);
+            let got = RateLimit { max: max / 0.5 }.apply(&(anchor + tau), &anchor, 0, 0.5);
+            let step = (anchor + tau) - anchor;
+            let n = step.norm();
+            let want = if n > max {
+                anchor + step * (max / n)
+            } else {
+                anchor + tau
+            };
+            assert!(
+                got.iter()
+                    .zip(&want)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
+        }
+        assert!(near > 50_000, "{near} torques near the limit");
+        for tau in [
+            Vector3::new(f64::INFINITY, 0.0, 0.0),
+            Vector3::new(f64::NAN, 1.0, 0.0),
+            Vector3::new(1e160, 1e160, 0.0),
+        ] {
+            let got = Saturation::Norm { max: 1e200 }.apply(&tau);
+            let want = formula(&tau, 1e200);
+            assert!(
+                got.iter()
+                    .zip(&want)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
+        }
     }
 
     #[test]

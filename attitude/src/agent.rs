@@ -23,6 +23,7 @@ use crate::network::{AgentModel, AgentState, Exchanged, Scheme};
 use crate::observer::{
     LeaderInput, omega_hat_dot_7b, omega_hat_dot_16b, r_hat_rate, sigma_hat_dot_7c,
 };
+use crate::sensor::Sensing;
 use crate::timeline::{Absent, Due};
 use crate::verdict::Verdicts;
 use nalgebra::{Matrix3, Vector3};
@@ -596,22 +597,20 @@ impl Agent {
             // Nobody receives it: the receivers' timelines drop it.
             return exchanged_of(&self.model.scheme, &self.state);
         }
-        match self.sensed_stage() {
-            Some(m) => exchanged_of(&self.model.scheme, &m),
+        match self.sensed() {
+            Some(s) => exchanged_of(&self.model.scheme, &s.measure(&self.stage_x)),
             None => exchanged_of(&self.model.scheme, &self.stage_x),
         }
     }
 
-    /// The stage state as its sensors measure it, for an observerless agent
-    /// with sensors (it publishes what it measures; with an observer it
-    /// publishes the observer's state, which it knows exactly).
-    fn sensed_stage(&self) -> Option<AgentState> {
+    /// The sensors whose measurement an observerless agent publishes (it
+    /// knows nothing better of itself; with an observer it publishes the
+    /// observer's state, which it knows exactly).
+    fn sensed(&self) -> Option<&Sensing> {
         if self.model.scheme.has_observer() {
             return None;
         }
-        let state = self.timed.as_deref()?.effects.as_ref();
-        let slot = (self.n, self.step.stage());
-        at(&self.model, state, slot, self.step.h(), self.tau0)?.measure(&self.stage_x)
+        self.timed.as_deref()?.effects.as_ref()?.sensing()
     }
 
     /// The guard's check of the state at the start of the current step
@@ -645,19 +644,15 @@ impl Agent {
     #[inline]
     pub(crate) fn publish_into(&mut self, out: &mut Exchanged) -> bool {
         *out = self.stage_exchange();
-        if self.is_down()
-            || self
-                .model
-                .effects
-                .as_ref()
-                .is_some_and(|e| e.sensor.is_some())
-        {
-            // a measured attitude is not the integrator's stage point: no proof
+        if self.is_down() {
             return out.trust().is_ok();
         }
+        // a measured attitude is the stage point turned by the sensors' `exp(η^×)`
+        let turned = self.sensed().map(Sensing::eta2);
         let published = usize::from(self.model.scheme.has_observer());
         let u = &self.step.increments()[published];
-        (self.verdicts).judge(out, self.n, self.step.stage(), u)
+        let slot = (self.n, self.step.stage());
+        (self.verdicts).judge(out, slot, u, turned)
     }
 
     /// Stores the value received from the `k`-th neighbour (order of `model.neighbours`).

@@ -72,6 +72,12 @@ impl EffectsState {
         (!noise.is_empty() || sensing.is_some()).then_some(Self { noise, sensing })
     }
 
+    /// The sensors' errors of the current step, when the body has sensors.
+    #[must_use]
+    pub fn sensing(&self) -> Option<&Sensing> {
+        self.sensing.as_ref()
+    }
+
     /// Draws what step `n` holds (at its start, for every step in order).
     pub fn step(&mut self, e: &Effects, n: u64) {
         for p in &mut self.noise {

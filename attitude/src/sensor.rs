@@ -57,6 +57,8 @@ pub struct Sensing {
     rng: SplitMix64,
     /// `exp(η^×)`.
     e: Matrix3<f64>,
+    /// `‖η‖²`, what [`crate::verdict`] proves the measured attitude from.
+    eta2: f64,
     nu: Vector3<f64>,
 }
 
@@ -67,14 +69,24 @@ impl Sensing {
         Self {
             rng: SplitMix64(sensor.seed),
             e: Matrix3::identity(),
+            eta2: 0.0,
             nu: Vector3::zeros(),
         }
     }
 
     /// Draws the errors of the next step: `η` (attitude), then `ν` (rate).
     pub fn step(&mut self, sensor: &Sensor) {
-        self.e = exp(&sensor.attitude.draw(&mut self.rng));
+        let eta = sensor.attitude.draw(&mut self.rng);
+        self.e = exp(&eta);
+        self.eta2 = eta.norm_squared();
         self.nu = sensor.rate.draw(&mut self.rng);
+    }
+
+    /// `‖η‖²` of the current step: the measured attitude is the body's
+    /// turned by `exp(η^×)`, a rotation of angle `‖η‖`.
+    #[must_use]
+    pub fn eta2(&self) -> f64 {
+        self.eta2
     }
 
     /// What the law measures of `x`: `(Rᵢ exp(η^×), ωᵢ + ν)`, the observer

@@ -24,6 +24,19 @@
 //!
 //! So the attitude's part of [`Exchanged::trust`] holds, and the verdict is
 //! that of the vectors alone (finite or not), evaluated as `trust` does.
+//!
+//! An observerless agent with sensors publishes what it measures,
+//! `fl(P · S)` at every stage, `P` the stage point above and
+//! `S = fl(exp(η))` its sensors' rotation for the step (`PROTOCOL.md`
+//! § 10.13). With `‖η‖² ≤` [`MAX_INCREMENT2`], `S` is a rotation to
+//! `1e-14` with entries bounded by 2, exactly as `E` is, so the same
+//! argument carries once more: `d(fl(P S)) ≤ d(P) + 1e-13`. Judged at
+//! stage 0 is `fl(Q S)`, whose defect `d'` bounds `Q`'s:
+//! `Q = (QS)Sᵀ` up to roundings, `d(Q) ≤ d' + 1e-13`; so with `d' ≤`
+//! [`MARGIN`] every stage's published defect stays below `1.1e-8`, and
+//! the determinants stay positive as above. When the guard has checked the
+//! step's start state instead, its defect is `Q`'s own, and `fl(Q S)`'s
+//! verdict is proven from it in the same way (`d(Q) ≤ MARGIN`).
 //! Outside these conditions (a diverging node, a huge increment) the check
 //! runs in full. The engine's verdicts are therefore exactly
 //! `trust().is_ok()`, bit-identical runs included (tested in `agent.rs`).
@@ -76,18 +89,30 @@ impl Verdicts {
         self.checked = (Step::of(n), defect);
     }
 
-    /// The verdict on `x`, published at stage `stage` of step `n`, whose
+    /// The verdict on `x`, published at stage `s` of step `n`, whose
     /// attitude is the step's start attitude times `exp(u)` (at stage 0:
-    /// the start attitude itself). Always equal to `x.trust().is_ok()`.
-    pub fn judge(&mut self, x: &Exchanged, n: u64, stage: usize, u: &Vector3<f64>) -> bool {
-        if stage == 0 {
+    /// the start attitude itself), turned by the sensors' rotation of
+    /// `‖η‖² = turned` when it is measured. Always equal to
+    /// `x.trust().is_ok()`.
+    pub fn judge(
+        &mut self,
+        x: &Exchanged,
+        (n, s): (u64, usize),
+        u: &Vector3<f64>,
+        turned: Option<f64>,
+    ) -> bool {
+        let small = turned.is_none_or(|eta2| eta2 <= MAX_INCREMENT2);
+        if s == 0 {
             let checked = std::mem::take(&mut self.checked);
             let defect = match checked {
-                (Some(m), d) if Some(m) == Step::of(n) => Some(d),
+                (Some(m), d) if Some(m) == Step::of(n) && turned.is_none() => Some(d),
+                (Some(m), d) if Some(m) == Step::of(n) && small && d <= MARGIN => {
+                    Self::vectors_finite(x).then_some(d)
+                }
                 _ => x.trusted_defect().ok(),
             };
             self.proven_for = defect
-                .is_some_and(|d| d <= MARGIN)
+                .is_some_and(|d| d <= MARGIN && small)
                 .then(|| Step::of(n))
                 .flatten();
             return defect.is_some();
@@ -95,10 +120,16 @@ impl Verdicts {
         if self.proven_for.is_some()
             && self.proven_for == Step::of(n)
             && u.norm_squared() <= MAX_INCREMENT2
+            && small
         {
-            return Exchanged::finite(x.w.as_slice()) && Exchanged::finite(x.s.as_slice());
+            return Self::vectors_finite(x);
         }
         x.trust().is_ok()
+    }
+
+    /// The vectors' part of [`Exchanged::trust`].
+    fn vectors_finite(x: &Exchanged) -> bool {
+        Exchanged::finite(x.w.as_slice()) && Exchanged::finite(x.s.as_slice())
     }
 }
 

@@ -3,14 +3,19 @@
 //! `attitude::verdict`) is exactly `Exchanged::trust().is_ok()` at every
 //! stage: for a network that converges, for one whose `dt` is far too large
 //! (its states blow up, turn non-finite, and its attitudes stop being
-//! rotations), and for each scheme.
+//! rotations), and for each scheme; with the guard's check of each step's
+//! start or without; and for an observerless agent publishing what noisy
+//! sensors measure, small errors (proven) and huge ones (checked).
 
 use attitude::agent::Agent;
 use attitude::body::Inertia;
 use attitude::control::ControlGains;
+use attitude::effects::Effects;
+use attitude::guard::Envelope;
 use attitude::network::{AgentModel, AgentState, Exchanged, Neighbour, Scheme};
 use attitude::observer::ObserverGains;
 use attitude::reference::{Leader, LeaderState};
+use attitude::sensor::{Noise, Sensor};
 use attitude::so3::rot;
 use nalgebra::{Matrix3, Vector3};
 
@@ -35,8 +40,33 @@ fn schemes(gain: f64) -> [Scheme; 3] {
     ]
 }
 
+/// How the chain is run: sensors' attitude noise (rad) and the guard.
+#[derive(Clone, Copy, Default)]
+struct Variant {
+    attitude_noise: Option<f64>,
+    guard: bool,
+}
+
+/// Sensors of attitude noise `std` (and a bias on both quantities).
+fn sensors(std: f64, id: u32) -> Box<Effects> {
+    Box::new(Effects {
+        sensor: Some(Sensor {
+            attitude: Noise {
+                std,
+                bias: [0.0, 1e-3, 0.0],
+            },
+            rate: Noise {
+                std: 1e-3,
+                bias: [0.0, 0.0, 1e-4],
+            },
+            seed: 17 + u64::from(id),
+        }),
+        ..Effects::default()
+    })
+}
+
 /// A chain of `n` agents (agent 1 hears the leader) under `scheme`.
-fn chain(n: u32, scheme: Scheme, dt: f64) -> (Leader, Vec<Agent>) {
+fn chain(n: u32, scheme: Scheme, dt: f64, v: Variant) -> (Leader, Vec<Agent>) {
     let p = Matrix3::new(-1.0, 0.0, 0.0, 0.0, 0.0, -0.7, 0.0, 0.7, 0.0);
     let axis = Vector3::new(1.0, 2.0, -0.5).normalize();
     let agents = (1..=n)
@@ -62,7 +92,7 @@ fn chain(n: u32, scheme: Scheme, dt: f64) -> (Leader, Vec<Agent>) {
                 p,
                 law: Default::default(),
                 timeline: Default::default(),
-                effects: None,
+                effects: v.attitude_noise.map(|std| sensors(std, id)),
             };
             let r = rot(0.5 + 0.7 * f64::from(id), &axis);
             let initial = AgentState {
@@ -85,10 +115,15 @@ fn chain(n: u32, scheme: Scheme, dt: f64) -> (Leader, Vec<Agent>) {
 
 /// Steps the chain for `steps` steps, continuous coupling, checking every
 /// published verdict; returns how many values were trusted and refused.
-fn check(scheme: Scheme, dt: f64, steps: usize) -> (usize, usize) {
-    let (mut leader, mut agents) = chain(5, scheme, dt);
+fn check(scheme: Scheme, dt: f64, steps: usize, v: Variant) -> (usize, usize) {
+    let (mut leader, mut agents) = chain(5, scheme, dt, v);
     let (mut yes, mut no) = (0, 0);
-    for _ in 0..steps * 4 {
+    for stage in 0..steps * 4 {
+        if v.guard && stage % 4 == 0 {
+            for a in &mut agents {
+                let _ = a.check(&Envelope::default());
+            }
+        }
         let mut published: Vec<(Exchanged, bool)> = Vec::new();
         for a in &mut agents {
             let (x, trusted) = a.stage_exchange_judged();
@@ -122,15 +157,50 @@ fn check(scheme: Scheme, dt: f64, steps: usize) -> (usize, usize) {
 #[test]
 fn verdicts_equal_trust_while_converging() {
     for scheme in schemes(1.0) {
-        let (yes, no) = check(scheme, 1e-3, 2_000);
-        assert_eq!((yes, no), (5 * 4 * 2_000, 0), "{scheme:?}");
+        for guard in [false, true] {
+            let v = Variant {
+                guard,
+                ..Variant::default()
+            };
+            let (yes, no) = check(scheme, 1e-3, 2_000, v);
+            assert_eq!((yes, no), (5 * 4 * 2_000, 0), "{scheme:?}");
+        }
     }
 }
 
 #[test]
 fn verdicts_equal_trust_while_diverging() {
     for scheme in schemes(50.0) {
-        let (yes, no) = check(scheme, 0.2, 60);
-        assert!(yes > 0 && no > 0, "{scheme:?}: {yes} trusted, {no} refused");
+        for guard in [false, true] {
+            let v = Variant {
+                guard,
+                ..Variant::default()
+            };
+            let (yes, no) = check(scheme, 0.2, 60, v);
+            assert!(yes > 0 && no > 0, "{scheme:?}: {yes} trusted, {no} refused");
+        }
+    }
+}
+
+#[test]
+fn verdicts_equal_trust_for_what_sensors_measure() {
+    let [.., observerless] = schemes(1.0);
+    // 1e-3 rad: every ‖η‖² ≤ 1, proven; 2 rad: many beyond, checked in full
+    for (std, guard) in [(1e-3, false), (1e-3, true), (2.0, false), (2.0, true)] {
+        let v = Variant {
+            attitude_noise: Some(std),
+            guard,
+        };
+        let (yes, no) = check(observerless, 1e-3, 500, v);
+        assert_eq!((yes, no), (5 * 4 * 500, 0), "std {std}, guard {guard}");
+    }
+    let [.., observerless] = schemes(50.0);
+    for guard in [false, true] {
+        let v = Variant {
+            attitude_noise: Some(1e-3),
+            guard,
+        };
+        let (yes, no) = check(observerless, 0.2, 60, v);
+        assert!(yes > 0 && no > 0, "{yes} trusted, {no} refused");
     }
 }
