@@ -15,6 +15,7 @@ use super::bridge_error::debug;
 use super::keys;
 use super::link::{Flow, LinkReceiver, LinkSender, STATE_DEPTH, STATE_FRESHEST, STATE_WINDOW};
 use super::local::{LocalNs, Shared};
+use super::mesh::Sessions;
 use super::wire::StateLink;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
@@ -35,11 +36,12 @@ pub struct Bridges {
 }
 
 impl Bridges {
-    /// Starts the threads of `links` on side `me`: one that sends every
-    /// link leaving `me`, one per link reaching `me`.
+    /// Starts the threads of `links` on side `me`: one per session that
+    /// sends the links leaving `me` over it, one per link reaching `me`;
+    /// each link over the session towards its other side.
     #[must_use]
     pub fn start(
-        session: &zenoh::Session,
+        sessions: &Sessions,
         ns: &LocalNs,
         run: &str,
         me: &Side,
@@ -47,13 +49,16 @@ impl Bridges {
         shared: &Shared,
     ) -> Self {
         let mut threads = Vec::new();
-        let out: Vec<StateLink> = links
-            .iter()
-            .filter(|l| l.from_side == *me)
-            .cloned()
-            .collect();
-        if !out.is_empty() {
-            let (s, ns, run, sh) = (session.clone(), ns.clone(), run.to_string(), shared.clone());
+        let mut out: Vec<(zenoh::Session, Vec<StateLink>)> = Vec::new();
+        for l in links.iter().filter(|l| l.from_side == *me) {
+            let s = sessions.towards(&l.to_side);
+            match out.iter_mut().find(|(o, _)| o.zid() == s.zid()) {
+                Some((_, group)) => group.push(l.clone()),
+                None => out.push((s.clone(), vec![l.clone()])),
+            }
+        }
+        for (s, out) in out {
+            let (ns, run, sh) = (ns.clone(), run.to_string(), shared.clone());
             threads.push(std::thread::spawn(move || {
                 if let Err(e) = send_states(&s, &ns, &run, &out, &sh) {
                     sh.fail(format!(
@@ -65,7 +70,7 @@ impl Bridges {
         }
         for l in links.iter().filter(|l| l.to_side == *me) {
             let (s, ns, key) = (
-                session.clone(),
+                sessions.towards(&l.from_side).clone(),
                 ns.clone(),
                 keys::state_link(run, l.from, &l.to_side),
             );

@@ -10,6 +10,7 @@ use super::Side;
 use super::bridge::Bridges;
 use super::keys;
 use super::local::{LocalNs, Shared};
+use super::mesh::{self, Sessions};
 use super::pieces;
 use super::plan::{Plan, links};
 use super::telemetry::{self, End, TelemetryThread};
@@ -166,7 +167,7 @@ impl Remote {
         let links = links(&configs, &self.plan);
         let (s, run) = (&self.session, self.run.as_str());
         self.bridges = Some(Bridges::start(
-            s,
+            &Sessions::single(s),
             ns,
             run,
             &Side::Orchestrator,
@@ -178,6 +179,7 @@ impl Remote {
             let sink = telemetry::start(End::Sink, s, ns, (run, &h.name), ids, &self.shared);
             self.sinks.push(sink);
         }
+        let mut dials = mesh::dials(&self.plan, &links);
         let mut pending = Vec::new();
         for h in &self.plan.hosts {
             let me = Side::Host(h.name.clone());
@@ -192,6 +194,7 @@ impl Remote {
                     .filter(|l| l.from_side == me || l.to_side == me)
                     .cloned()
                     .collect(),
+                dial: dials.remove(&h.name).unwrap_or_default(),
             };
             // The host fetches the request (in pieces) before it answers.
             let body = serde_json::to_vec(&req).expect("serialises");

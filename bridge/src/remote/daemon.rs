@@ -141,7 +141,7 @@ pub fn serve(opts: &HostOptions, stop: &AtomicBool, report: Report) -> Result<()
     let mut runs: HashMap<String, (Sender<Command>, JoinHandle<()>)> = HashMap::new();
     while !stop.load(Ordering::Relaxed) {
         if let Ok(Some(q)) = run_q.recv_timeout(Duration::from_millis(50)) {
-            accept(&session, (&name, &opts.allow, &report), q, &mut runs);
+            accept(&session, (&name, opts, &report), q, &mut runs);
         }
         while let Ok(Some(q)) = end_q.try_recv() {
             route_end(q, &runs);
@@ -175,7 +175,7 @@ fn refuse(q: &Query, why: String) {
 /// ([`host_run::serve_offer`]).
 fn accept(
     session: &zenoh::Session,
-    (name, allow, report): (&str, &Allowlist, &Report),
+    (name, opts, report): (&str, &HostOptions, &Report),
     q: Query,
     runs: &mut HashMap<String, (Sender<Command>, JoinHandle<()>)>,
 ) {
@@ -192,8 +192,10 @@ fn accept(
     let (tx, rx) = mpsc::channel();
     let s = session.clone();
     let run = req.run.clone();
-    let (allow, report) = (allow.clone(), report.clone());
-    let t = std::thread::spawn(move || host_run::serve_offer(s, req, q, rx, (&allow, &report)));
+    let (allow, report, security) = (opts.allow.clone(), report.clone(), opts.security.clone());
+    let t = std::thread::spawn(move || {
+        host_run::serve_offer(s, req, q, rx, (&allow, &report, &security));
+    });
     runs.insert(run, (tx, t));
 }
 

@@ -10,10 +10,12 @@ use super::bridge::Bridges;
 pub use super::host_run_error::{RequestError, StartError};
 use super::keys;
 use super::local::{LocalNs, Shared};
+use super::mesh::Sessions;
 use super::pieces;
 use super::report::{DaemonEvent, Report};
 use super::telemetry::{self, End, TelemetryThread};
 use super::wire::{Answer, EndReply, EndRequest, HostEvent, NodeEnd, RunOffer, RunRequest};
+use crate::trust::Security;
 use crate::trust::allow::{Allowlist, Asked};
 use iceoryx2::prelude::*;
 use launch::namespace::Namespace;
@@ -52,6 +54,7 @@ const TICK: Duration = Duration::from_millis(5);
 struct Resources {
     _telemetry: TelemetryThread,
     _bridges: Bridges,
+    _sessions: Sessions,
     control: iceoryx2::port::publisher::Publisher<ipc::Service, ControlMsg, ()>,
     _node: iceoryx2::node::Node<ipc::Service>,
     sup: Supervisor,
@@ -66,8 +69,10 @@ fn start(
     session: &zenoh::Session,
     req: &RunRequest,
     shared: &Shared,
+    security: &Security,
 ) -> Result<(Resources, Nodes), StartError> {
     let (agent_bin, leader_bin) = find_binaries()?;
+    let sessions = Sessions::dial(session, &req.host, &req.dial, security)?;
     let ns = Namespace::create().map_err(StartError::Namespace)?;
     let logs = ns.dir().join("logs");
     std::fs::create_dir_all(&logs).map_err(io_at(&logs))?;
@@ -85,7 +90,7 @@ fn start(
         .create()
         .map_err(iox("control publisher"))?;
     let me = Side::Host(req.host.clone());
-    let bridges = Bridges::start(session, &local, &req.run, &me, &req.links, shared);
+    let bridges = Bridges::start(&sessions, &local, &req.run, &me, &req.links, shared);
     let ids = req.nodes.iter().map(|n| n.config.id).collect();
     let telemetry = telemetry::start(
         End::Forward,
@@ -121,6 +126,7 @@ fn start(
     let r = Resources {
         _telemetry: telemetry,
         _bridges: bridges,
+        _sessions: sessions,
         control,
         _node: node,
         sup,
@@ -145,10 +151,10 @@ pub fn serve_offer(
     offer: RunOffer,
     reply: Query,
     commands: Receiver<Command>,
-    (allow, report): (&Allowlist, &Report),
+    (allow, report, security): (&Allowlist, &Report, &Security),
 ) {
     match fetch(&session, &offer).and_then(|r| admit(r, allow)) {
-        Ok(req) => serve(session, req, reply, (commands, report)),
+        Ok(req) => serve(session, req, reply, (commands, report, security)),
         Err(e) => {
             tracing::warn!(run = %offer.run, "refused: {e}");
             report(DaemonEvent::Refused {
@@ -243,7 +249,7 @@ pub fn serve(
     session: zenoh::Session,
     req: RunRequest,
     reply: Query,
-    (commands, report): (Receiver<Command>, &Report),
+    (commands, report, security): (Receiver<Command>, &Report, &Security),
 ) {
     let shared = Shared::default();
     // Declared before the answer, so that no command of the run is missed.
@@ -252,7 +258,7 @@ pub fn serve(
         answer(&reply, &Answer::Err(why.into()));
         return;
     };
-    let (mut res, nodes) = match start(&session, &req, &shared) {
+    let (mut res, nodes) = match start(&session, &req, &shared, security) {
         Ok(x) => x,
         Err(e) => {
             tracing::warn!(run = %req.run, "cannot start the run: {e}");
@@ -267,6 +273,7 @@ pub fn serve(
     report(DaemonEvent::Started {
         run: req.run.clone(),
         nodes: req.nodes.iter().map(|n| n.name.clone()).collect(),
+        dialled: req.dial.iter().map(|p| p.host.clone()).collect(),
     });
     answer(&reply, &Answer::Ok(()));
     drop(reply); // its final reply: the orchestrator's query completes

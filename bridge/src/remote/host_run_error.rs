@@ -83,4 +83,7 @@ pub enum StartError {
     /// The supervisor's runtime could not start.
     #[error("tokio runtime: {0}")]
     Runtime(std::io::Error),
+    /// A peer the run needs could not be reached.
+    #[error(transparent)]
+    Mesh(#[from] super::mesh::MeshError),
 }

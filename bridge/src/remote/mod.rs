@@ -14,6 +14,7 @@
 //! - [`local`]: a run's namespace on one side, the stop flag and first failure.
 //! - [`bridge`], [`telemetry`]: the threads that carry states and telemetry.
 //! - [`plan`]: which host runs which node; the state links between sides.
+//! - [`mesh`]: the links between hosts the orchestrator wires for a run.
 //! - [`client`]: the orchestrator's side ([`Remote`]; its errors [`RemoteError`]).
 //! - [`daemon`], [`host_run`]: the host's side; [`report`]: what it says
 //!   on its stdout.
@@ -28,6 +29,7 @@ mod host_run_error;
 pub mod keys;
 pub mod link;
 pub mod local;
+pub mod mesh;
 pub mod pieces;
 pub mod plan;
 pub mod report;

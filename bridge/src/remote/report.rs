@@ -24,6 +24,8 @@ pub enum DaemonEvent {
         run: String,
         /// The nodes it started (their names).
         nodes: Vec<String>,
+        /// The hosts it dialled for the run.
+        dialled: Vec<String>,
     },
     /// It refused a run, or could not start it (nothing runs).
     Refused {
@@ -53,13 +55,21 @@ impl fmt::Display for DaemonEvent {
                 }
                 Ok(())
             }
-            Self::Started { run, nodes } => {
+            Self::Started {
+                run,
+                nodes,
+                dialled,
+            } => {
                 write!(
                     f,
                     "run {run}: started {} nodes ({})",
                     nodes.len(),
                     nodes.join(", ")
-                )
+                )?;
+                if !dialled.is_empty() {
+                    write!(f, "; dialled host {}", dialled.join(", host "))?;
+                }
+                Ok(())
             }
             Self::Refused { run, why } => write!(f, "run {run}: refused: {why}"),
         }
@@ -88,10 +98,20 @@ mod tests {
         let started = DaemonEvent::Started {
             run: "r1".into(),
             nodes: vec!["agent-1".into(), "leader".into()],
+            dialled: Vec::new(),
         };
         assert_eq!(
             started.to_string(),
             "run r1: started 2 nodes (agent-1, leader)"
+        );
+        let meshed = DaemonEvent::Started {
+            run: "r2".into(),
+            nodes: vec!["agent-4".into()],
+            dialled: vec!["a".into(), "b".into()],
+        };
+        assert_eq!(
+            meshed.to_string(),
+            "run r2: started 1 nodes (agent-4); dialled host a, host b"
         );
         for e in [listening, started] {
             assert!(!e.to_string().contains('\n'));

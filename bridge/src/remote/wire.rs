@@ -78,6 +78,19 @@ pub struct RunRequest {
     pub nodes: Vec<RemoteNode>,
     /// Every state link touching this host.
     pub links: Vec<StateLink>,
+    /// The hosts it dials for the run ([`super::mesh`]).
+    #[serde(default)]
+    pub dial: Vec<Peer>,
+}
+
+/// A host another dials for a run: its name and its daemon's endpoint
+/// (HOSTS.toml's).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Peer {
+    /// Its name.
+    pub host: String,
+    /// Its daemon's endpoint.
+    pub endpoint: String,
 }
 
 /// A daemon's answer to a request: accepted, or refused with why (on the
