@@ -60,7 +60,7 @@ impl Transport {
 
 /// An `attsync host` in a mount namespace of its own; killed (its whole
 /// process group) when dropped.
-struct HostDaemon {
+pub(crate) struct HostDaemon {
     name: String,
     endpoint: String,
     child: Child,
@@ -86,7 +86,7 @@ fn security_flags(transport: Transport, certs: &Path, name: &str) -> Vec<String>
 }
 
 impl HostDaemon {
-    fn start(
+    pub(crate) fn start(
         attsync: &Path,
         work: &Path,
         (name, transport): (&str, Transport),
@@ -186,7 +186,12 @@ pub fn blocks(nodes: u32, parts: usize) -> Vec<Vec<u32>> {
 }
 
 /// HOSTS.toml placing block `k + 1` on `hosts[k]`, over `t`.
-fn hosts_toml(hosts: &[HostDaemon], blocks: &[Vec<u32>], t: Transport, certs: &Path) -> String {
+pub(crate) fn hosts_toml(
+    hosts: &[HostDaemon],
+    blocks: &[Vec<u32>],
+    t: Transport,
+    certs: &Path,
+) -> String {
     let mut text = match t {
         Transport::Tcp => String::from("insecure = true\n\n"),
         Transport::Quic => format!(

@@ -30,7 +30,8 @@
 //!   `ring-node` process.
 //! - [`scale`]: `scale` — the in-process engine against N and threads.
 //! - [`hosts`]: `hosts` — one scenario on one machine and split over 2
-//!   and 3 hosts on loopback (daemons in mount namespaces of their own).
+//!   and 3 hosts on loopback (daemons in mount namespaces of their own);
+//!   [`crossing`]: then a cut edge hop by hop, with lookahead, in real time.
 //! - [`zping`]: `zenoh-ping` — Zenoh's own round trip on loopback, next to
 //!   plain TCP (the floor under the bridge across hosts).
 //! - [`procs`]: child processes with bounded waits; [`stats`]: medians, CPU
@@ -38,6 +39,7 @@
 
 mod bare;
 mod conclusions;
+mod crossing;
 mod error;
 mod hosts;
 mod measure;
@@ -186,6 +188,10 @@ enum Cmd {
         /// Machine counts, comma-separated (1: the orchestrator's alone).
         #[arg(long, value_delimiter = ',', default_value = "1,2,3")]
         machines: Vec<usize>,
+        /// Delays on every link for the lookahead table, in steps,
+        /// comma-separated.
+        #[arg(long, value_delimiter = ',', default_value = "0,1,2,4,20")]
+        delays: Vec<u64>,
     },
     /// (internal) The echoing end of `zenoh-ping`.
     ZenohPong {
@@ -285,7 +291,8 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             duration,
             reps,
             machines,
-        } => hosts_table(scenario, duration, reps, machines),
+            delays,
+        } => hosts_table(scenario, duration, reps, (machines, delays)),
         Cmd::ZenohPong { connect, transport } => zping::pong(&connect, transport),
         Cmd::ZenohPing {
             payload,
@@ -386,12 +393,19 @@ fn hosts_table(
     scenario: Option<PathBuf>,
     duration: f64,
     reps: usize,
-    machines: Vec<usize>,
+    (machines, delays): (Vec<usize>, Vec<u64>),
 ) -> anyhow::Result<()> {
     let bench = std::env::current_exe().context("own path")?;
     let dir = bench.parent().map(PathBuf::from).unwrap_or_default();
     let scenario = scenario.unwrap_or_else(|| in_repository("scenarios/paper/timevarying.toml"));
     let work = std::env::temp_dir().join(format!("attsync-bench-hosts-{}", std::process::id()));
+    let crossing = crossing::Options {
+        scenario: scenario.clone(),
+        duration,
+        reps,
+        delays,
+        work: work.clone(),
+    };
     let o = hosts::Options {
         scenario,
         duration,
@@ -409,8 +423,12 @@ fn hosts_table(
         stats::loadavg()
     );
     let placed = hosts::measure(&o, &bins);
+    let crossed = placed.is_ok().then(|| crossing::measure(&crossing, &bins));
     let _ = std::fs::remove_dir_all(&work);
     print!("{}", hosts::table(&placed?));
+    if let Some(c) = crossed {
+        print!("{}", crossing::tables(&c?));
+    }
     println!("load average after: {}", stats::loadavg());
     Ok(())
 }
