@@ -170,7 +170,13 @@ fn exchange<S: Service, N: Stepper, H: Hooks>(
 ) -> Result<(), NodeError> {
     let first = slot.step == 0 && slot.stage == 0;
     let msg = StateMsg::new(cfg.id, slot.step, slot.stage, &stepper.stage_exchange()).stamped_now();
-    io.publish(slot, msg, first)?;
+    // Woken at every exchange: a receiver on another host is a bridge that
+    // sleeps on its wake event (a node here never waits on it after t = 0).
+    io.publish(slot, msg, true)?;
+    if !first {
+        // What our senders' notifications left on our own wake event.
+        let _ = io.ports.listener.try_wait(|_| {});
+    }
     for k in 0..cfg.inputs.len() {
         let deadline = Instant::now() + Duration::from_secs_f64(cfg.stage_timeout);
         let mut fresh = None;
