@@ -21,8 +21,8 @@ pub struct Host {
     /// `tcp/…` with --insecure); repeatable.
     #[arg(long, required_unless_present = "gen_certs")]
     pub listen: Vec<String>,
-    /// Endpoint of another host to dial (every pair of hosts that share a
-    /// cut edge must be connected: dial the hosts started before); repeatable.
+    /// Endpoint of another host to dial for good; repeatable. Not needed:
+    /// a run dials the peers it needs from HOSTS.toml (docs/hosts.md).
     #[arg(long)]
     pub connect: Vec<String>,
     /// The lab's CA certificate (PEM): only peers with a certificate it
