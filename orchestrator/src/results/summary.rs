@@ -313,34 +313,46 @@ impl Summary {
     #[must_use]
     pub fn table(&self) -> String {
         let mut s = String::new();
+        self.write_agents(&mut s);
+        self.write_links(&mut s);
+        self.write_run(&mut s);
+        s
+    }
+
+    /// The agents' rows under a two-line header.
+    fn write_agents(&self, s: &mut String) {
         let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.3e}"));
         let time = |x: Option<f64>| x.map_or("never".to_string(), |v| format!("{v:.2}"));
-        let _ = writeln!(
-            s,
-            "{:>5} {:>10} {:>12} {:>10} {:>12} {:>14} {:>14} {:>16} {:>12}",
-            "agent",
-            "att_err",
-            "angvel_err",
-            "obs_att",
-            "obs_angvel",
-            "settle_att",
-            "settle_att",
-            "settle_angvel",
-            "peak_tau"
-        );
-        let _ = writeln!(
-            s,
-            "{:>5} {:>10} {:>12} {:>10} {:>12} {:>14} {:>14} {:>16} {:>12}",
-            "",
-            "[1]",
-            "[rad/s]",
-            "[1]",
-            "[rad/s]",
-            "<1e-3 [s]",
-            "<1e-6 [s]",
-            "<1e-3 rad/s [s]",
-            "[N m]"
-        );
+        for head in [
+            [
+                "agent",
+                "att_err",
+                "angvel_err",
+                "obs_att",
+                "obs_angvel",
+                "settle_att",
+                "settle_att",
+                "settle_angvel",
+                "peak_tau",
+            ],
+            [
+                "",
+                "[1]",
+                "[rad/s]",
+                "[1]",
+                "[rad/s]",
+                "<1e-3 [s]",
+                "<1e-6 [s]",
+                "<1e-3 rad/s [s]",
+                "[N m]",
+            ],
+        ] {
+            let [a, b, c, d, e, f, g, h, i] = head;
+            let _ = writeln!(
+                s,
+                "{a:>5} {b:>10} {c:>12} {d:>10} {e:>12} {f:>14} {g:>14} {h:>16} {i:>12}"
+            );
+        }
         for a in &self.agents {
             let _ = writeln!(
                 s,
@@ -356,6 +368,10 @@ impl Summary {
                 a.peak_torque
             );
         }
+    }
+
+    /// A line per listed link.
+    fn write_links(&self, s: &mut String) {
         for l in &self.links {
             let _ = writeln!(
                 s,
@@ -363,6 +379,10 @@ impl Summary {
                 l.from, l.to, l.sent, l.delivered, l.lost, l.rejected, l.aoi_mean, l.aoi_max
             );
         }
+    }
+
+    /// The run's line, then its verdict, a hosts warning and `--until`.
+    fn write_run(&self, s: &mut String) {
         let mode = match self.realtime {
             Some(f) => format!(" real-time ×{f}"),
             None => String::new(),
@@ -392,24 +412,22 @@ impl Summary {
             let _ = write!(s, "\nwarning: {w}");
         }
         if let Some(u) = &self.until {
-            let _ = write!(
-                s,
-                "\n--until settled: {} s in {} chunk(s), {}",
-                u.duration,
-                u.chunks,
-                match u.stopped {
-                    super::until::Stopped::VerdictFinal =>
-                        "stopped when the verdict was final".to_string(),
-                    super::until::Stopped::MaxDuration => format!(
-                        "stopped at --max-duration {} s before the verdict was final",
-                        u.max_duration
-                    ),
-                    super::until::Stopped::RunEnded => "stopped when the run ended".to_string(),
-                }
-            );
+            let _ = write!(s, "\n--until settled: {}", until_line(u));
         }
-        s
     }
+}
+
+/// How `--until settled` ended, for [`Summary::table`].
+fn until_line(u: &super::until::UntilSummary) -> String {
+    let how = match u.stopped {
+        super::until::Stopped::VerdictFinal => "stopped when the verdict was final".to_string(),
+        super::until::Stopped::MaxDuration => format!(
+            "stopped at --max-duration {} s before the verdict was final",
+            u.max_duration
+        ),
+        super::until::Stopped::RunEnded => "stopped when the run ended".to_string(),
+    };
+    format!("{} s in {} chunk(s), {how}", u.duration, u.chunks)
 }
 
 /// One line for a verdict: its kind, the decay rate and what follows from it.
