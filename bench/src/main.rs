@@ -203,49 +203,53 @@ enum Cmd {
         transport: zping::Transport,
     },
     /// (internal) One process of the bare iceoryx2 lockstep ring.
-    RingNode {
-        /// Run id (iceoryx2 namespace).
-        #[arg(long)]
-        run: String,
-        /// Run directory (iceoryx2 root ROOT/iox, barrier files).
-        #[arg(long)]
-        root: PathBuf,
-        /// This node's id.
-        #[arg(long)]
-        index: u32,
-        /// Number of nodes.
-        #[arg(long)]
-        n: u32,
-        /// Steps (4 exchanges each).
-        #[arg(long)]
-        steps: u64,
-        /// Wait strategy.
-        #[arg(long, value_enum)]
-        wait: WaitArg,
-        /// Input ids, comma-separated (default: the ring neighbours; may be empty).
-        #[arg(long)]
-        inputs: Option<String>,
-        /// Receiver ids, comma-separated (default: the ring neighbours).
-        #[arg(long)]
-        outputs: Option<String>,
-        /// Fan-out limit of the services (default 2, the ring's).
-        #[arg(long, default_value_t = 2)]
-        max_fanout: usize,
-        /// Longest wait for one exchange's inputs, s.
-        #[arg(long, default_value_t = 10.0)]
-        stage_timeout: f64,
-        /// Longest wait at each barrier, s.
-        #[arg(long, default_value_t = 120.0)]
-        barrier_timeout: f64,
-        /// Longest single sleep on the wake event, ms (a lost wake-up costs this).
-        #[arg(long, default_value_t = 1)]
-        block_slice_ms: u64,
-        /// Adaptive: block for a while after a stolen yield, as a node that
-        /// nothing places does (default: not, as attsync's nodes under its
-        /// default placement).
-        #[arg(long)]
-        stolen_holds: bool,
-    },
+    RingNode(RingNodeArgs),
+}
+
+/// `ring-node`'s flags.
+#[derive(Debug, clap::Args)]
+struct RingNodeArgs {
+    /// Run id (iceoryx2 namespace).
+    #[arg(long)]
+    run: String,
+    /// Run directory (iceoryx2 root ROOT/iox, barrier files).
+    #[arg(long)]
+    root: PathBuf,
+    /// This node's id.
+    #[arg(long)]
+    index: u32,
+    /// Number of nodes.
+    #[arg(long)]
+    n: u32,
+    /// Steps (4 exchanges each).
+    #[arg(long)]
+    steps: u64,
+    /// Wait strategy.
+    #[arg(long, value_enum)]
+    wait: WaitArg,
+    /// Input ids, comma-separated (default: the ring neighbours; may be empty).
+    #[arg(long)]
+    inputs: Option<String>,
+    /// Receiver ids, comma-separated (default: the ring neighbours).
+    #[arg(long)]
+    outputs: Option<String>,
+    /// Fan-out limit of the services (default 2, the ring's).
+    #[arg(long, default_value_t = 2)]
+    max_fanout: usize,
+    /// Longest wait for one exchange's inputs, s.
+    #[arg(long, default_value_t = 10.0)]
+    stage_timeout: f64,
+    /// Longest wait at each barrier, s.
+    #[arg(long, default_value_t = 120.0)]
+    barrier_timeout: f64,
+    /// Longest single sleep on the wake event, ms (a lost wake-up costs this).
+    #[arg(long, default_value_t = 1)]
+    block_slice_ms: u64,
+    /// Adaptive: block for a while after a stolen yield, as a node that
+    /// nothing places does (default: not, as attsync's nodes under its
+    /// default placement).
+    #[arg(long)]
+    stolen_holds: bool,
 }
 
 fn id_list(s: Option<String>) -> anyhow::Result<Option<Vec<u32>>> {
@@ -310,43 +314,7 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             scale_table(&agents, &threads, &scheme, (exact, budget));
             Ok(())
         }
-        Cmd::RingNode {
-            run,
-            root,
-            index,
-            n,
-            steps,
-            wait,
-            inputs,
-            outputs,
-            max_fanout,
-            stage_timeout,
-            barrier_timeout,
-            block_slice_ms,
-            stolen_holds,
-        } => {
-            let node = ring::RingNode {
-                run,
-                root,
-                index,
-                n,
-                steps,
-                wait: wait.into(),
-                inputs: id_list(inputs)?,
-                outputs: id_list(outputs)?,
-                max_fanout,
-                stage_timeout,
-                barrier_timeout,
-                block_slice: std::time::Duration::from_millis(block_slice_ms),
-                contention: if stolen_holds {
-                    Contention::Waiter
-                } else {
-                    Contention::Placement
-                },
-            };
-            println!("{}", node.run()?.line());
-            Ok(())
-        }
+        Cmd::RingNode(a) => ring_node(a),
         Cmd::Run {
             quick,
             out,
@@ -373,6 +341,31 @@ fn dispatch(cmd: Cmd) -> anyhow::Result<()> {
             run(opts, out)
         }
     }
+}
+
+/// `attsync-bench ring-node`: runs one node of the bare ring, prints its line.
+fn ring_node(a: RingNodeArgs) -> anyhow::Result<()> {
+    let node = ring::RingNode {
+        run: a.run,
+        root: a.root,
+        index: a.index,
+        n: a.n,
+        steps: a.steps,
+        wait: a.wait.into(),
+        inputs: id_list(a.inputs)?,
+        outputs: id_list(a.outputs)?,
+        max_fanout: a.max_fanout,
+        stage_timeout: a.stage_timeout,
+        barrier_timeout: a.barrier_timeout,
+        block_slice: std::time::Duration::from_millis(a.block_slice_ms),
+        contention: if a.stolen_holds {
+            Contention::Waiter
+        } else {
+            Contention::Placement
+        },
+    };
+    println!("{}", node.run()?.line());
+    Ok(())
 }
 
 /// `rel` in the current directory if it is there, else in the repository

@@ -12,6 +12,7 @@
 //! hosts and the endpoint that did not answer.
 
 use super::Side;
+use super::client::REACH_TIMEOUT;
 use super::keys;
 use super::plan::Plan;
 use super::wire::{Peer, StateLink};
@@ -22,9 +23,6 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 use zenoh::Wait;
 use zenoh::query::ConsolidationMode;
-
-/// How long a host may take to reach the peers it dials for a run.
-pub const REACH_TIMEOUT: Duration = Duration::from_secs(5);
 
 /// A run's links to its peers could not be made.
 #[derive(Debug, Error)]
