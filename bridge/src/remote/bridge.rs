@@ -1,21 +1,23 @@
-//! The bridge of a run's cut edges on one side: for each local sender with
-//! receivers elsewhere, a thread that reads its iceoryx2 state service and
-//! puts every message on a [`LinkSender`]; for each remote sender with
-//! receivers here, a thread that takes its messages off a [`LinkReceiver`]
-//! and publishes them into a local state service for that sender, with
-//! attsync's own service settings (`msgs::open::state`), waking the
-//! receivers. The receiving node sees a normal local input. The exact
-//! bytes travel, in order, losslessly: lockstep stays byte-identical. In
-//! real time the links carry the newest states first
-//! ([`super::link::STATE_FRESHEST`]), as a network would.
+//! The bridge of a run's cut edges on one side: for each session, a thread
+//! that reads the iceoryx2 state services of the local senders with
+//! receivers elsewhere and sends their states, a bundle at a time, on one
+//! [`TrunkSender`] per side they go to; for each remote sender with
+//! receivers here, a thread that takes its states off its
+//! [`TrunkReceiver`]'s inbox and publishes them into a local state service
+//! for that sender, with attsync's own service settings
+//! (`msgs::open::state`), waking the receivers. The receiving node sees a
+//! normal local input. The exact bytes travel, in order, losslessly:
+//! lockstep stays byte-identical. In real time the trunks carry the newest
+//! states first, as a network would.
 
 use super::Side;
 pub use super::bridge_error::BridgeError;
 use super::bridge_error::debug;
 use super::keys;
-use super::link::{Flow, LinkReceiver, LinkSender, STATE_DEPTH, STATE_FRESHEST, STATE_WINDOW};
+use super::link::{Flow, Window};
 use super::local::{LocalNs, Shared};
 use super::mesh::Sessions;
+use super::trunk::{BUNDLE_MOST, TrunkInput, TrunkReceiver, TrunkSender};
 use super::wire::StateLink;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
@@ -33,12 +35,14 @@ const SLICE: Duration = Duration::from_millis(1);
 pub struct Bridges {
     shared: Shared,
     threads: Vec<JoinHandle<()>>,
+    _trunks: Vec<TrunkReceiver>,
 }
 
 impl Bridges {
     /// Starts the threads of `links` on side `me`: one per session that
-    /// sends the links leaving `me` over it, one per link reaching `me`;
-    /// each link over the session towards its other side.
+    /// sends the links leaving `me` over it (a [`TrunkSender`] per side
+    /// they go to), one per link reaching `me` (fed by the
+    /// [`TrunkReceiver`] of the side it comes from).
     #[must_use]
     pub fn start(
         sessions: &Sessions,
@@ -49,15 +53,7 @@ impl Bridges {
         shared: &Shared,
     ) -> Self {
         let mut threads = Vec::new();
-        let mut out: Vec<(zenoh::Session, Vec<StateLink>)> = Vec::new();
-        for l in links.iter().filter(|l| l.from_side == *me) {
-            let s = sessions.towards(&l.to_side);
-            match out.iter_mut().find(|(o, _)| o.zid() == s.zid()) {
-                Some((_, group)) => group.push(l.clone()),
-                None => out.push((s.clone(), vec![l.clone()])),
-            }
-        }
-        for (s, out) in out {
+        for (s, out) in outgoing(sessions, me, links) {
             let (ns, run, sh) = (ns.clone(), run.to_string(), shared.clone());
             threads.push(std::thread::spawn(move || {
                 if let Err(e) = send_states(&s, &ns, &run, &out, &sh) {
@@ -68,27 +64,69 @@ impl Bridges {
                 }
             }));
         }
-        for l in links.iter().filter(|l| l.to_side == *me) {
-            let (s, ns, key) = (
-                sessions.towards(&l.from_side).clone(),
-                ns.clone(),
-                keys::state_link(run, l.from, &l.to_side),
-            );
-            let (l, sh) = (l.clone(), shared.clone());
-            threads.push(std::thread::spawn(move || {
-                if let Err(e) = receive_states(&s, &ns, &key, &l, &sh) {
-                    sh.fail(format!(
-                        "bridge of node {}'s states to {}: {e}",
-                        l.from, l.to_side
-                    ));
+        let mut trunks = Vec::new();
+        for (from, inc) in incoming(me, links) {
+            let key = keys::state_trunk(run, &from, me);
+            let senders = inc.iter().map(|l| l.from).collect();
+            let session = sessions.towards(&from);
+            let trunk = match TrunkReceiver::open(session, &key, senders, state_flow(ns)) {
+                Ok(t) => t,
+                Err(e) => {
+                    shared.fail(format!("bridge of the states from {from}: {e}"));
+                    continue;
                 }
-            }));
+            };
+            for l in inc {
+                let Some(input) = trunk.input(l.from) else {
+                    continue;
+                };
+                let (ns, sh) = (ns.clone(), shared.clone());
+                threads.push(std::thread::spawn(move || {
+                    if let Err(e) = receive_states(&ns, input, &l, &sh) {
+                        sh.fail(format!(
+                            "bridge of node {}'s states to {}: {e}",
+                            l.from, l.to_side
+                        ));
+                    }
+                }));
+            }
+            trunks.push(trunk);
         }
         Self {
             shared: shared.clone(),
             threads,
+            _trunks: trunks,
         }
     }
+}
+
+/// The links leaving `me`, grouped by the session they go over.
+fn outgoing(
+    sessions: &Sessions,
+    me: &Side,
+    links: &[StateLink],
+) -> Vec<(zenoh::Session, Vec<StateLink>)> {
+    let mut out: Vec<(zenoh::Session, Vec<StateLink>)> = Vec::new();
+    for l in links.iter().filter(|l| l.from_side == *me) {
+        let s = sessions.towards(&l.to_side);
+        match out.iter_mut().find(|(o, _)| o.zid() == s.zid()) {
+            Some((_, group)) => group.push(l.clone()),
+            None => out.push((s.clone(), vec![l.clone()])),
+        }
+    }
+    out
+}
+
+/// The links reaching `me`, grouped by the side they come from (a trunk each).
+fn incoming(me: &Side, links: &[StateLink]) -> Vec<(Side, Vec<StateLink>)> {
+    let mut inc: Vec<(Side, Vec<StateLink>)> = Vec::new();
+    for l in links.iter().filter(|l| l.to_side == *me) {
+        match inc.iter_mut().find(|(f, _)| *f == l.from_side) {
+            Some((_, group)) => group.push(l.clone()),
+            None => inc.push((l.from_side.clone(), vec![l.clone()])),
+        }
+    }
+    inc
 }
 
 impl Drop for Bridges {
@@ -102,19 +140,16 @@ impl Drop for Bridges {
 
 /// One link's sending end: a subscriber per receiver over there (the
 /// sender counts its receivers before it is ready), the first forwarded,
-/// the others drained.
-/// The first is read into `queue` (at most a window) also while the
-/// window is shut.
+/// the others drained. The first is read into `queue` (at most a window)
+/// also while the window is shut.
 struct Outgoing {
     subs: Vec<StateSubscriber>,
-    queue: std::collections::VecDeque<Vec<u8>>,
-    link: LinkSender,
+    queue: std::collections::VecDeque<StateMsg>,
 }
 
 impl Outgoing {
-    /// Reads what the queue holds and forwards what the window allows;
-    /// whether anything moved.
-    fn pump(&mut self) -> Result<bool, BridgeError> {
+    /// Reads what the queue holds room for; whether anything moved.
+    fn read(&mut self, most: usize) -> Result<bool, BridgeError> {
         let mut moved = false;
         for s in &self.subs[1..] {
             while s
@@ -123,44 +158,77 @@ impl Outgoing {
                 .is_some()
             {}
         }
-        while self.queue.len() < QUEUE {
+        while self.queue.len() < most {
             let Some(m) = self.subs[0]
                 .receive()
                 .map_err(|e| BridgeError::Receive(debug(e)))?
             else {
                 break;
             };
-            self.queue.push_back(m.to_bytes());
-            moved = true;
-        }
-        while self.link.has_credit() {
-            let Some(bytes) = self.queue.pop_front() else {
-                break;
-            };
-            self.link.send_now(bytes)?;
+            self.queue.push_back(*m);
             moved = true;
         }
         Ok(moved)
     }
 }
 
-/// The states a link's sending end reads ahead of its window.
-const QUEUE: usize = STATE_DEPTH;
+/// The links towards one side: their trunk and their sending ends, in the
+/// trunk's order.
+struct Towards {
+    trunk: TrunkSender,
+    links: Vec<Outgoing>,
+}
 
-/// How `ns`'s cut edges carry states: every one in lockstep, the newest
-/// first in real time.
-fn state_flow(ns: &LocalNs) -> Flow {
-    if ns.realtime {
-        STATE_FRESHEST
-    } else {
-        STATE_WINDOW
+impl Towards {
+    /// Reads every link and sends what their windows allow, in bundles of
+    /// at most [`BUNDLE_MOST`]; whether anything moved.
+    fn pump(&mut self, most: usize) -> Result<bool, BridgeError> {
+        let mut moved = false;
+        for o in &mut self.links {
+            moved |= o.read(most)?;
+        }
+        loop {
+            let mut bundle = Vec::new();
+            let mut counts = vec![0u64; self.links.len()];
+            let mut room = BUNDLE_MOST;
+            for (i, o) in self.links.iter_mut().enumerate() {
+                let n = o.queue.len().min(self.trunk.credit(i)).min(room);
+                for m in o.queue.drain(..n) {
+                    bundle.extend_from_slice(&m.to_bytes());
+                }
+                counts[i] = n as u64;
+                room -= n;
+            }
+            if bundle.is_empty() {
+                return Ok(moved);
+            }
+            self.trunk.send(bundle, &counts)?;
+            moved = true;
+        }
     }
 }
 
-/// The sending side of every link leaving this side, on one thread that
-/// sleeps on the wake events of the receivers over there (nobody else
-/// listens to them on this side). A link without credit leaves its
-/// messages in iceoryx2 (holding its sender back) and never blocks another.
+/// How `ns`'s cut edges carry states: every one in lockstep, within a
+/// window of a receiver's buffer (`Limits::state_buffer`); the newest
+/// `state_buffer` first in real time.
+fn state_flow(ns: &LocalNs) -> Flow {
+    let depth = ns.limits.state_buffer.max(1);
+    if ns.realtime {
+        Flow::Freshest { depth }
+    } else {
+        let window = depth as u64;
+        Flow::Window(Window {
+            window,
+            ack_every: (window / 4).max(1),
+        })
+    }
+}
+
+/// The sending side of every link leaving this side over `session`, on
+/// one thread that sleeps on the wake events of the receivers over there
+/// (nobody else listens to them on this side). A link without credit
+/// leaves its messages in iceoryx2 (holding its sender back) and never
+/// blocks another.
 fn send_states(
     session: &zenoh::Session,
     ns: &LocalNs,
@@ -169,37 +237,28 @@ fn send_states(
     sh: &Shared,
 ) -> Result<(), BridgeError> {
     let node = ns.node("bridge-out")?;
-    let mut out = Vec::new();
-    for l in links {
-        let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits)?;
-        let key = keys::state_link(run, l.from, &l.to_side);
-        let link = LinkSender::open(session, &key, state_flow(ns))?;
-        if !publisher_is_up(&svc, sh) {
-            return Ok(()); // the run ended first
+    let mut towards: Vec<Towards> = Vec::new();
+    for (to, group) in by_destination(links) {
+        let senders = group.iter().map(|l| l.from).collect();
+        let key = keys::state_trunk(run, &group[0].from_side, &to);
+        let trunk = TrunkSender::open(session, &key, senders, state_flow(ns))?;
+        let mut outs = Vec::new();
+        for l in group {
+            let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits)?;
+            if !publisher_is_up(&svc, sh) {
+                return Ok(()); // the run ended first
+            }
+            let subs = (l.receivers.iter())
+                .map(|_| subscribe(&svc, ns.limits.state_buffer))
+                .collect::<Result<Vec<_>, _>>()?;
+            outs.push(Outgoing {
+                subs,
+                queue: std::collections::VecDeque::new(),
+            });
         }
-        let subs = (l.receivers.iter())
-            .map(|_| subscribe(&svc, ns.limits.state_buffer))
-            .collect::<Result<Vec<_>, _>>()?;
-        out.push(Outgoing {
-            subs,
-            queue: std::collections::VecDeque::new(),
-            link,
-        });
+        towards.push(Towards { trunk, links: outs });
     }
-    let mut remote: Vec<u32> = links
-        .iter()
-        .flat_map(|l| l.receivers.iter().copied())
-        .collect();
-    remote.sort_unstable();
-    remote.dedup();
-    let listeners = (remote.iter())
-        .map(|&r| {
-            msgs::open::wake(&node, &ns.run, r, &ns.limits)?
-                .listener_builder()
-                .create()
-                .map_err(|e| BridgeError::from(iox("bridge wake listener")(e)))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let listeners = wake_listeners(&node, ns, links)?;
     let waitset = WaitSetBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
@@ -208,6 +267,7 @@ fn send_states(
         .map(|l| waitset.attach_notification(l))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| BridgeError::WaitSet(debug(e)))?;
+    let most = ns.limits.state_buffer.max(1);
     while !sh.stopping() {
         let _ =
             waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, SLICE);
@@ -217,12 +277,46 @@ fn send_states(
         let mut moved = true;
         while moved {
             moved = false;
-            for o in &mut out {
-                moved |= o.pump()?;
+            for t in &mut towards {
+                moved |= t.pump(most)?;
             }
         }
     }
     Ok(())
+}
+
+/// `links` grouped by the side they go to, in their order.
+fn by_destination(links: &[StateLink]) -> Vec<(Side, Vec<&StateLink>)> {
+    let mut by: Vec<(Side, Vec<&StateLink>)> = Vec::new();
+    for l in links {
+        match by.iter_mut().find(|(to, _)| *to == l.to_side) {
+            Some((_, group)) => group.push(l),
+            None => by.push((l.to_side.clone(), vec![l])),
+        }
+    }
+    by
+}
+
+/// A listener of the wake event of every receiver of `links` (a node
+/// notifies its receivers when it publishes).
+fn wake_listeners(
+    node: &iceoryx2::node::Node<ipc::Service>,
+    ns: &LocalNs,
+    links: &[StateLink],
+) -> Result<Vec<iceoryx2::port::listener::Listener<ipc::Service>>, BridgeError> {
+    let mut remote: Vec<u32> = (links.iter())
+        .flat_map(|l| l.receivers.iter().copied())
+        .collect();
+    remote.sort_unstable();
+    remote.dedup();
+    (remote.iter())
+        .map(|&r| {
+            msgs::open::wake(node, &ns.run, r, &ns.limits)?
+                .listener_builder()
+                .create()
+                .map_err(|e| BridgeError::from(iox("bridge wake listener")(e)))
+        })
+        .collect()
 }
 
 /// Waits until the sender's publisher exists (a node opens it before it
@@ -257,11 +351,10 @@ type StateSubscriber = iceoryx2::port::subscriber::Subscriber<ipc::Service, Stat
 
 /// The receiving side of `l`: the sender's only publisher on this side,
 /// holding back (like a node's own publisher) while a receiver's buffer is
-/// full, at most the stage timeout.
+/// full, at most the stage timeout; its states come off `input`.
 fn receive_states(
-    session: &zenoh::Session,
     ns: &LocalNs,
-    key: &str,
+    mut input: TrunkInput,
     l: &StateLink,
     sh: &Shared,
 ) -> Result<(), BridgeError> {
@@ -281,9 +374,8 @@ fn receive_states(
                 .map_err(|e| BridgeError::from(iox("bridge wake notifier")(e)))
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let mut link = LinkReceiver::open(session, key, state_flow(ns))?;
     while !sh.stopping() {
-        let Some(bytes) = link.recv(SLICE * 20)? else {
+        let Some(bytes) = input.recv(SLICE * 20)? else {
             continue;
         };
         let m = StateMsg::from_bytes(&bytes)?;
@@ -295,7 +387,7 @@ fn receive_states(
             want: l.receivers.len(),
         };
         deliver(&publisher, &to, m, ns.stage_timeout, sh)?;
-        link.delivered()?;
+        input.delivered()?;
     }
     Ok(())
 }

@@ -61,10 +61,11 @@ pub fn events(run: &str, host: &str) -> String {
     format!("attsync/{run}/events/{host}")
 }
 
-/// Node `from`'s states towards side `to` (`StateMsg` bytes); acks at `<key>/ack`.
+/// The states of every cut edge from side `from` to side `to` (bundles of
+/// `StateMsg` bytes, [`super::trunk`]); acks at `<key>/ack`.
 #[must_use]
-pub fn state_link(run: &str, from: u32, to: &Side) -> String {
-    format!("attsync/{run}/state/{from}/{}", to.key())
+pub fn state_trunk(run: &str, from: &Side, to: &Side) -> String {
+    format!("attsync/{run}/states/{}/{}", from.key(), to.key())
 }
 
 /// A host's telemetry (service id + `TelemetryMsg` bytes), daemon → orchestrator.

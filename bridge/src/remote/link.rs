@@ -54,19 +54,6 @@ pub enum Flow {
     },
 }
 
-/// A state link's depth, in messages: a state subscriber's buffer
-/// (`msgs::Limits::state_buffer`).
-pub const STATE_DEPTH: usize = 64;
-
-/// State links in lockstep: [`STATE_DEPTH`] in flight.
-pub const STATE_WINDOW: Flow = Flow::Window(Window {
-    window: STATE_DEPTH as u64,
-    ack_every: 16,
-});
-
-/// State links in real time (PROTOCOL § 7): [`STATE_DEPTH`], newest first.
-pub const STATE_FRESHEST: Flow = Flow::Freshest { depth: STATE_DEPTH };
-
 /// Telemetry links: as deep as the orchestrator's telemetry buffer.
 pub const TELEMETRY_WINDOW: Flow = Flow::Window(Window {
     window: 256,
@@ -101,6 +88,19 @@ fn zerr(e: impl std::fmt::Display) -> LinkError {
     LinkError::Zenoh(e.to_string())
 }
 
+/// A reliable publisher of `key` that sends each message at once
+/// (`express`) and blocks rather than drops (`Block`).
+pub(super) fn express_publisher(
+    session: &zenoh::Session,
+    key: String,
+) -> Result<Publisher<'static>, LinkError> {
+    (session.declare_publisher(key))
+        .congestion_control(CongestionControl::Block)
+        .express(true)
+        .wait()
+        .map_err(zerr)
+}
+
 /// Acknowledged count (`None` before the hello), shared with the ack callback.
 type Acked = Arc<(Mutex<Option<u64>>, Condvar)>;
 
@@ -116,12 +116,7 @@ pub struct LinkSender {
 impl LinkSender {
     /// Declares the publisher of `key` and the subscriber of its acks.
     pub fn open(session: &zenoh::Session, key: &str, flow: Flow) -> Result<Self, LinkError> {
-        let publisher = session
-            .declare_publisher(key.to_string())
-            .congestion_control(CongestionControl::Block)
-            .express(true)
-            .wait()
-            .map_err(zerr)?;
+        let publisher = express_publisher(session, key.to_string())?;
         let acked: Acked = Arc::new((Mutex::new(None), Condvar::new()));
         let a = acked.clone();
         let acks = session
@@ -245,12 +240,7 @@ impl LinkReceiver {
     /// publisher of its acks, and says hello.
     pub fn open(session: &zenoh::Session, key: &str, flow: Flow) -> Result<Self, LinkError> {
         let data = Inbox::declare(session, key, flow)?;
-        let acks = session
-            .declare_publisher(super::keys::ack(key))
-            .congestion_control(CongestionControl::Block)
-            .express(true)
-            .wait()
-            .map_err(zerr)?;
+        let acks = express_publisher(session, super::keys::ack(key))?;
         let r = Self {
             data,
             acks,

@@ -11,6 +11,8 @@
 //!   scouting, the low-latency transport).
 //! - [`pieces`]: payloads larger than one Zenoh batch, as replies in pieces.
 //! - [`link`]: a lossless, ordered, bounded stream (data + acknowledgements).
+//! - [`trunk`]: every cut edge between two sides on one key, bundled, a
+//!   window per edge, acknowledgements batched.
 //! - [`local`]: a run's namespace on one side, the stop flag and first failure.
 //! - [`bridge`], [`telemetry`]: the threads that carry states and telemetry.
 //! - [`plan`]: which host runs which node; the state links between sides.
@@ -34,6 +36,7 @@ pub mod pieces;
 pub mod plan;
 pub mod report;
 pub mod telemetry;
+pub mod trunk;
 pub mod wire;
 pub mod zconfig;
 
