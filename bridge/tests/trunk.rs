@@ -3,8 +3,8 @@
 //! link whose receiver stalls holds back only itself; real time keeps the
 //! newest; a bundle that is not states is named.
 
-use bridge::remote::link::{Flow, Window};
-use bridge::remote::trunk::{BUNDLE_MOST, TrunkReceiver, TrunkSender};
+use bridge::remote::link::{Flow, LinkError, Window};
+use bridge::remote::trunk::{BUNDLE_MOST, Direct, TrunkReceiver, TrunkSender};
 use bridge::remote::zconfig;
 use bridge::trust::Security;
 use msgs::StateMsg;
@@ -36,6 +36,19 @@ fn state(sender: u32, step: u64) -> StateMsg {
     m.step = step;
     m.w = [step as f64, f64::from(sender), -1.5];
     m
+}
+
+fn ms(n: u64) -> Duration {
+    Duration::from_millis(n)
+}
+
+/// A delivery that checks each state of `sender` comes in order.
+fn check(sender: u32, got: &mut u64) -> impl FnOnce(Vec<u8>) -> Result<(), LinkError> + '_ {
+    move |bytes| {
+        assert_eq!(StateMsg::from_bytes(&bytes).unwrap(), state(sender, *got));
+        *got += 1;
+        Ok(())
+    }
 }
 
 /// Waits up to 10 s for `ok`.
@@ -74,10 +87,10 @@ fn every_state_arrives_once_in_order_and_a_stalled_link_holds_back_only_itself()
     let senders = vec![3, 0, 7];
     let rx = TrunkReceiver::open(&b, &key, senders.clone(), WINDOW).expect("receiver");
     let mut tx = TrunkSender::open(&a, &key, senders.clone(), WINDOW).expect("sender");
-    let mut inputs: Vec<_> = senders.iter().map(|&s| rx.input(s).unwrap()).collect();
+    let inputs: Vec<_> = senders.iter().map(|&s| rx.input(s).unwrap()).collect();
     // an idle receiver repeats its hello (the first went before anyone listened)
     until("the hello", || {
-        assert!(inputs[0].recv(Duration::from_millis(5)).unwrap().is_none());
+        assert!(!inputs[0].take(ms(5), |_| Ok::<_, LinkError>(())).unwrap());
         tx.credit(0) > 0
     });
     let per = 200;
@@ -92,14 +105,10 @@ fn every_state_arrives_once_in_order_and_a_stalled_link_holds_back_only_itself()
         );
         pump(&mut tx, &mut next, per);
         for i in 0..2 {
-            while let Some(bytes) = inputs[i].recv(Duration::from_millis(1)).unwrap() {
-                assert_eq!(
-                    StateMsg::from_bytes(&bytes).unwrap(),
-                    state(senders[i], got[i])
-                );
-                got[i] += 1;
-                inputs[i].delivered().unwrap();
-            }
+            while inputs[i]
+                .take(ms(1), check(senders[i], &mut got[i]))
+                .unwrap()
+            {}
         }
     }
     assert_eq!(next[2], 8, "the stalled link sent its window, no more");
@@ -111,13 +120,9 @@ fn every_state_arrives_once_in_order_and_a_stalled_link_holds_back_only_itself()
             "stuck at {got:?}"
         );
         pump(&mut tx, &mut next, per);
-        if let Some(bytes) = inputs[2].recv(Duration::from_millis(1)).unwrap() {
-            assert_eq!(StateMsg::from_bytes(&bytes).unwrap(), state(7, got[2]));
-            got[2] += 1;
-            inputs[2].delivered().unwrap();
-        }
+        inputs[2].take(ms(1), check(7, &mut got[2])).unwrap();
     }
-    assert!(inputs[2].recv(Duration::from_millis(50)).unwrap().is_none());
+    assert!(!inputs[2].take(ms(50), check(7, &mut got[2])).unwrap());
     until("every count acknowledged", || {
         (0..3).all(|i| tx.credit(i) >= 7)
     });
@@ -129,9 +134,9 @@ fn in_real_time_an_inbox_keeps_the_newest_states() {
     let flow = Flow::Freshest { depth: 4 };
     let rx = TrunkReceiver::open(&b, &key, vec![5], flow).expect("receiver");
     let mut tx = TrunkSender::open(&a, &key, vec![5], flow).expect("sender");
-    let mut input = rx.input(5).unwrap();
+    let input = rx.input(5).unwrap();
     until("the hello", || {
-        assert!(input.recv(Duration::from_millis(5)).unwrap().is_none());
+        assert!(!input.take(ms(5), |_| Ok::<_, LinkError>(())).unwrap());
         tx.credit(0) > 0
     });
     for n in 0..100 {
@@ -140,9 +145,11 @@ fn in_real_time_an_inbox_keeps_the_newest_states() {
     std::thread::sleep(Duration::from_secs(1)); // all arrive meanwhile
     let mut steps = Vec::new();
     until("the last state", || {
-        if let Some(b) = input.recv(Duration::from_millis(5)).unwrap() {
+        let got = |b: Vec<u8>| {
             steps.push(StateMsg::from_bytes(&b).unwrap().step);
-        }
+            Ok::<_, LinkError>(())
+        };
+        input.take(ms(5), got).unwrap();
         steps.last() == Some(&99)
     });
     assert_eq!(steps, [96, 97, 98, 99]);
@@ -157,15 +164,61 @@ fn a_bundle_that_is_not_states_of_its_links_is_named() {
         let (a, b, key) = pair();
         let rx = TrunkReceiver::open(&b, &key, vec![5], WINDOW).expect("receiver");
         let publisher = a.declare_publisher(key.clone()).wait().expect("publisher");
-        let mut input = rx.input(5).unwrap();
+        let input = rx.input(5).unwrap();
         let start = Instant::now();
         let err = loop {
             assert!(start.elapsed() < Duration::from_secs(10), "no error");
             publisher.put(bad.clone()).wait().expect("put");
-            if let Err(e) = input.recv(Duration::from_millis(20)) {
+            if let Err(e) = input.take(ms(20), |_| Ok::<_, LinkError>(())) {
                 break e;
             }
         };
         assert!(err.to_string().contains(says), "{err}");
     }
+}
+
+/// Takes what the link's thread is not busy with, refusing every third.
+struct Picky(std::sync::Arc<std::sync::Mutex<Vec<u64>>>);
+
+impl Direct for Picky {
+    fn try_now(&self, state: &[u8]) -> Result<bool, String> {
+        let step = StateMsg::from_bytes(state).map_err(|e| e.to_string())?.step;
+        if step % 3 == 0 {
+            return Ok(false);
+        }
+        self.0.lock().unwrap().push(step);
+        Ok(true)
+    }
+}
+
+#[test]
+fn states_delivered_from_the_callback_never_overtake_those_left_to_the_thread() {
+    let (a, b, key) = pair();
+    let rx = TrunkReceiver::open(&b, &key, vec![2], WINDOW).expect("receiver");
+    let mut tx = TrunkSender::open(&a, &key, vec![2], WINDOW).expect("sender");
+    let input = rx.input(2).unwrap();
+    let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    input.set_direct(std::sync::Arc::new(Picky(seen.clone())));
+    until("the hello", || {
+        assert!(!input.take(ms(5), |_| Ok::<_, LinkError>(())).unwrap());
+        tx.credit(0) > 0
+    });
+    let per = 3000;
+    let mut next = vec![0];
+    let start = Instant::now();
+    while seen.lock().unwrap().len() < per as usize {
+        assert!(start.elapsed() < Duration::from_secs(30), "stuck");
+        pump(&mut tx, &mut next, per);
+        let slow = |b: Vec<u8>| {
+            std::thread::sleep(Duration::from_micros(200)); // the thread holds back
+            seen.lock()
+                .unwrap()
+                .push(StateMsg::from_bytes(&b).unwrap().step);
+            Ok::<_, LinkError>(())
+        };
+        input.take(ms(1), slow).unwrap();
+    }
+    let seen = seen.lock().unwrap();
+    assert_eq!(*seen, (0..per).collect::<Vec<_>>());
+    until("every state acknowledged", || tx.credit(0) >= 7);
 }

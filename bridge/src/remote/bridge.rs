@@ -17,13 +17,14 @@ use super::keys;
 use super::link::{Flow, Window};
 use super::local::{LocalNs, Shared};
 use super::mesh::Sessions;
-use super::trunk::{BUNDLE_MOST, TrunkInput, TrunkReceiver, TrunkSender};
+use super::trunk::{BUNDLE_MOST, Direct, TrunkInput, TrunkReceiver, TrunkSender};
 use super::wire::StateLink;
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use msgs::StateMsg;
 use msgs::bytes::Bytes;
 use msgs::iox::iox;
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
@@ -351,14 +352,16 @@ type StateSubscriber = iceoryx2::port::subscriber::Subscriber<ipc::Service, Stat
 
 /// The receiving side of `l`: the sender's only publisher on this side,
 /// holding back (like a node's own publisher) while a receiver's buffer is
-/// full, at most the stage timeout; its states come off `input`.
+/// full, at most the stage timeout; its states come off `input`, or go
+/// straight from Zenoh's callback when `l` has one receiver here and its
+/// buffer has room ([`Republisher`]).
 fn receive_states(
     ns: &LocalNs,
-    mut input: TrunkInput,
+    input: TrunkInput,
     l: &StateLink,
     sh: &Shared,
 ) -> Result<(), BridgeError> {
-    let node = ns.node(&format!("bridge-in-{}", l.from))?;
+    let node = ns.shared_node(&format!("bridge-in-{}", l.from))?;
     let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits)?;
     let publisher = svc
         .publisher_builder()
@@ -374,88 +377,116 @@ fn receive_states(
                 .map_err(|e| BridgeError::from(iox("bridge wake notifier")(e)))
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let to = Arc::new(Republisher {
+        publisher,
+        notifiers,
+        want: l.receivers.len(),
+    });
+    if to.want == 1 {
+        input.set_direct(to.clone());
+    }
     while !sh.stopping() {
-        let Some(bytes) = input.recv(SLICE * 20)? else {
-            continue;
-        };
-        let m = StateMsg::from_bytes(&bytes)?;
-        if sh.stopping() {
-            break;
-        }
-        let to = Receivers {
-            notifiers: &notifiers,
-            want: l.receivers.len(),
-        };
-        deliver(&publisher, &to, m, ns.stage_timeout, sh)?;
-        input.delivered()?;
+        input.take(SLICE * 20, |bytes| {
+            let m = StateMsg::from_bytes(&bytes)?;
+            if sh.stopping() {
+                return Ok(());
+            }
+            to.deliver(m, ns.stage_timeout, sh)
+        })?;
     }
     Ok(())
 }
 
-/// The local receivers of a bridged state: their wake events and how many
-/// subscribers a message must reach.
-struct Receivers<'a> {
-    notifiers: &'a [iceoryx2::port::notifier::Notifier<ipc::Service>],
+type SharedPublisher = iceoryx2::port::publisher::Publisher<ipc_threadsafe::Service, StateMsg, ()>;
+type SharedNotifier = iceoryx2::port::notifier::Notifier<ipc_threadsafe::Service>;
+
+/// A remote sender's publisher on this side and its local receivers' wake
+/// events, shared by its bridge thread and Zenoh's callback.
+struct Republisher {
+    publisher: SharedPublisher,
+    notifiers: Vec<SharedNotifier>,
+    /// How many subscribers a state must reach.
     want: usize,
 }
 
-/// Publishes `m` to every local receiver and wakes them. iceoryx2 0.10
-/// skips, without an error, a receiver whose buffer is full while its side
-/// of the connection is not established yet (it connects when it next
-/// polls): a send that reached nobody is repeated every 50 µs, waking the
-/// receivers, until it is delivered, at most `timeout`. Lockstep cannot
-/// lose a message, so one that reached only some of several receivers
-/// fails the run, named, instead of being skipped.
-fn deliver(
-    publisher: &iceoryx2::port::publisher::Publisher<ipc::Service, StateMsg, ()>,
-    to: &Receivers<'_>,
-    m: StateMsg,
-    timeout: Duration,
-    sh: &Shared,
-) -> Result<(), BridgeError> {
-    let start = std::time::Instant::now();
-    loop {
-        let got = (publisher.send_copy(m)).map_err(iox("bridge state send"))?;
-        for n in to.notifiers {
+thread_local! {
+    /// This thread delivers from Zenoh's callback: never hold back.
+    static AT_ONCE: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+impl Direct for Republisher {
+    /// With one receiver: a send that cannot deliver at once fails having
+    /// reached nobody, and the state goes to the link's thread.
+    fn try_now(&self, state: &[u8]) -> Result<bool, String> {
+        let m = StateMsg::from_bytes(state).map_err(|e| e.to_string())?;
+        AT_ONCE.set(true);
+        let sent = self.publisher.send_copy(m);
+        AT_ONCE.set(false);
+        if !matches!(sent, Ok(n) if n >= self.want) {
+            return Ok(false);
+        }
+        self.wake();
+        Ok(true)
+    }
+}
+
+impl Republisher {
+    fn wake(&self) {
+        for n in &self.notifiers {
             let _ = n.notify();
         }
-        if got >= to.want {
-            return Ok(());
+    }
+
+    /// Publishes `m` to every local receiver and wakes them. iceoryx2 0.10
+    /// skips, without an error, a receiver whose buffer is full while its
+    /// side of the connection is not established yet (it connects when it
+    /// next polls): a send that reached nobody is repeated every 50 µs,
+    /// waking the receivers, until it is delivered, at most `timeout`.
+    /// Lockstep cannot lose a message, so one that reached only some of
+    /// several receivers fails the run, named, instead of being skipped.
+    fn deliver(&self, m: StateMsg, timeout: Duration, sh: &Shared) -> Result<(), BridgeError> {
+        let start = std::time::Instant::now();
+        loop {
+            let got = (self.publisher.send_copy(m)).map_err(iox("bridge state send"))?;
+            self.wake();
+            if got >= self.want {
+                return Ok(());
+            }
+            let (step, stage) = (m.step, m.stage);
+            if got > 0 {
+                let want = self.want;
+                return Err(BridgeError::Partial {
+                    step,
+                    stage,
+                    got,
+                    want,
+                });
+            }
+            if sh.stopping() {
+                return Ok(()); // the run is ending: nobody waits for it
+            }
+            if start.elapsed() > timeout {
+                let seconds = timeout.as_secs_f64();
+                return Err(BridgeError::Undelivered {
+                    step,
+                    stage,
+                    seconds,
+                });
+            }
+            std::thread::sleep(Duration::from_micros(50));
         }
-        let (step, stage) = (m.step, m.stage);
-        if got > 0 {
-            let want = to.want;
-            return Err(BridgeError::Partial {
-                step,
-                stage,
-                got,
-                want,
-            });
-        }
-        if sh.stopping() {
-            return Ok(()); // the run is ending: nobody waits for it
-        }
-        if start.elapsed() > timeout {
-            let seconds = timeout.as_secs_f64();
-            return Err(BridgeError::Undelivered {
-                step,
-                stage,
-                seconds,
-            });
-        }
-        std::thread::sleep(Duration::from_micros(50));
     }
 }
 
 /// A backpressure handler: retry every 50 µs, give up after `timeout` or
-/// when the run stops.
+/// when the run stops; at once in Zenoh's callback ([`AT_ONCE`]).
 fn hold_back(
     timeout: Duration,
     sh: Shared,
 ) -> impl Fn(&iceoryx2::port::BackpressureInfo) -> iceoryx2::port::BackpressureAction + Send + 'static
 {
     move |info| {
-        if info.elapsed_time > timeout || sh.stopping() {
+        if AT_ONCE.get() || info.elapsed_time > timeout || sh.stopping() {
             iceoryx2::port::BackpressureAction::DiscardDataAndFail
         } else {
             std::thread::sleep(Duration::from_micros(50));

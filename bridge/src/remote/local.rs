@@ -32,6 +32,12 @@ impl LocalNs {
     pub fn node(&self, name: &str) -> Result<Node<ipc::Service>, IoxError> {
         create_node::<ipc::Service>(&self.run, &self.dir, name)
     }
+
+    /// An iceoryx2 node `name` whose ports may be shared between threads
+    /// (the same services and shared memory as [`Self::node`]'s).
+    pub fn shared_node(&self, name: &str) -> Result<Node<ipc_threadsafe::Service>, IoxError> {
+        create_node::<ipc_threadsafe::Service>(&self.run, &self.dir, name)
+    }
 }
 
 /// What every bridge thread of a run shares: the stop flag and the first failure.

@@ -14,10 +14,12 @@
 //! count, sent once per `ack_every` deliveries over the whole trunk (and
 //! as the hello, every [`HELLO_EVERY`] while idle).
 //!
-//! Why not publish into iceoryx2 from the callback itself: a receiver's
-//! buffer may be full (its sender ran ahead) while the same receiver waits
-//! for another sender's state in the same bundle; a publish that blocks
-//! there would hold up the whole trunk, so each sender keeps a thread.
+//! A state goes into iceoryx2 straight from the callback when it can
+//! ([`Direct`]: its inbox is empty, its thread idle, and it is delivered at
+//! once); else it waits in the inbox for its thread, which may hold back.
+//! A publish must never block the callback: a receiver whose buffer is full
+//! (its sender ran ahead) may be waiting for another sender's state in the
+//! same bundle.
 
 use super::link::{Flow, HELLO_EVERY, LinkError, express_publisher};
 use msgs::StateMsg;
@@ -149,11 +151,39 @@ fn book_ack(acked: &Acked, senders: &[u32], bytes: &[u8]) {
     cv.notify_all();
 }
 
+/// Delivers a link's state at once from Zenoh's callback, or says it
+/// cannot without waiting.
+pub trait Direct: Send + Sync {
+    /// `Ok(true)`: delivered; `Ok(false)`: not now (the link's thread will);
+    /// `Err`: the state cannot be delivered, why.
+    fn try_now(&self, state: &[u8]) -> Result<bool, String>;
+}
+
 /// One link's inbox: its states in order, at most `depth` (a window's
-/// worth plus slack, or the newest `depth` in real time).
+/// worth plus slack, or the newest `depth` in real time); `busy` while
+/// its thread delivers one, so that a direct delivery never overtakes it.
 struct Inbox {
     queue: Mutex<VecDeque<Vec<u8>>>,
     ready: Condvar,
+    direct: std::sync::OnceLock<Arc<dyn Direct>>,
+    busy: Mutex<()>,
+}
+
+impl Inbox {
+    /// Delivers `state` from the callback if it is first in line and goes
+    /// at once (`q`: the locked queue).
+    fn direct(&self, q: &VecDeque<Vec<u8>>, state: &[u8]) -> Result<bool, String> {
+        let Some(d) = self.direct.get() else {
+            return Ok(false);
+        };
+        if !q.is_empty() {
+            return Ok(false);
+        }
+        let Ok(_busy) = self.busy.try_lock() else {
+            return Ok(false);
+        };
+        d.try_now(state)
+    }
 }
 
 /// What the receiving end's callback and its links share.
@@ -183,6 +213,20 @@ impl Shared {
             };
             let inbox = &self.inboxes[i];
             let mut q = lock(&inbox.queue);
+            match inbox.direct(&q, state) {
+                Ok(false) => {}
+                Ok(true) => {
+                    drop(q);
+                    if let Err(e) = self.book(i) {
+                        return self.fault(e.to_string());
+                    }
+                    continue;
+                }
+                Err(e) => {
+                    drop(q);
+                    return self.fault(e);
+                }
+            }
             if q.len() >= self.depth {
                 if self.lossless {
                     drop(q);
@@ -200,6 +244,17 @@ impl Shared {
         for i in &self.inboxes {
             i.ready.notify_all();
         }
+    }
+
+    /// Books one of link `i`'s states as delivered; acknowledges every
+    /// link's count once the trunk has delivered `ack_every` since the
+    /// last acknowledgement.
+    fn book(&self, i: usize) -> Result<(), LinkError> {
+        self.delivered[i].fetch_add(1, Ordering::SeqCst);
+        if self.since_ack.fetch_add(1, Ordering::SeqCst) + 1 >= self.ack_every {
+            self.ack()?;
+        }
+        Ok(())
     }
 
     /// Puts every link's delivered count.
@@ -238,6 +293,8 @@ impl TrunkReceiver {
                 .map(|_| Inbox {
                     queue: Mutex::new(VecDeque::new()),
                     ready: Condvar::new(),
+                    direct: std::sync::OnceLock::new(),
+                    busy: Mutex::new(()),
                 })
                 .collect(),
             delivered: senders.iter().map(|_| AtomicU64::new(0)).collect(),
@@ -284,9 +341,21 @@ pub struct TrunkInput {
 }
 
 impl TrunkInput {
-    /// The next state, waiting at most `timeout`; an idle trunk repeats
-    /// its acknowledgement every [`HELLO_EVERY`].
-    pub fn recv(&mut self, timeout: Duration) -> Result<Option<Vec<u8>>, LinkError> {
+    /// Lets Zenoh's callback deliver this link's states itself when it
+    /// can (set once; later calls are ignored).
+    pub fn set_direct(&self, d: Arc<dyn Direct>) {
+        let _ = self.shared.inboxes[self.i].direct.set(d);
+    }
+
+    /// Hands the next state to `deliver`, waiting at most `timeout` for
+    /// one (`Ok(false)`: none came), and books it as delivered; no direct
+    /// delivery overtakes it meanwhile. An idle trunk repeats its
+    /// acknowledgement every [`HELLO_EVERY`].
+    pub fn take<E: From<LinkError>>(
+        &self,
+        timeout: Duration,
+        deliver: impl FnOnce(Vec<u8>) -> Result<(), E>,
+    ) -> Result<bool, E> {
         let sh = &*self.shared;
         let inbox = &sh.inboxes[self.i];
         let mut q = lock(&inbox.queue);
@@ -296,24 +365,22 @@ impl TrunkInput {
                 .0;
         }
         if let Some(f) = lock(&sh.fault).clone() {
-            return Err(f);
+            return Err(f.into());
         }
-        let got = q.pop_front();
+        if q.is_empty() {
+            drop(q);
+            if lock(&sh.last_ack).elapsed() >= HELLO_EVERY {
+                sh.ack()?;
+            }
+            return Ok(false);
+        }
         drop(q);
-        if got.is_none() && lock(&sh.last_ack).elapsed() >= HELLO_EVERY {
-            sh.ack()?;
-        }
-        Ok(got)
-    }
-
-    /// Books one state as delivered; acknowledges every link's count once
-    /// the trunk has delivered `ack_every` since the last acknowledgement.
-    pub fn delivered(&mut self) -> Result<(), LinkError> {
-        let sh = &*self.shared;
-        sh.delivered[self.i].fetch_add(1, Ordering::SeqCst);
-        if sh.since_ack.fetch_add(1, Ordering::SeqCst) + 1 >= sh.ack_every {
-            sh.ack()?;
-        }
-        Ok(())
+        let _busy = lock(&inbox.busy);
+        let Some(state) = lock(&inbox.queue).pop_front() else {
+            return Ok(false); // only this thread takes: not reached
+        };
+        deliver(state)?;
+        sh.book(self.i)?;
+        Ok(true)
     }
 }
