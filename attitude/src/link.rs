@@ -123,6 +123,13 @@ pub struct LinkStats {
     /// (`Agent::receive_neighbour` / `receive_leader`) in every engine.
     #[serde(default)]
     pub rejected: u64,
+    /// The median age of information, s, when the runtime measured it
+    /// (real time: from a histogram, within 3.2 %); the model leaves it out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub age_p50: Option<f64>,
+    /// The 99th percentile of the age of information, s, likewise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub age_p99: Option<f64>,
 }
 
 /// A message on its way: delivery slot, stamp, value (ordered by slot, then stamp).

@@ -12,7 +12,7 @@
 //! - **lookahead**: with `network.delay` = k steps on every link, the two
 //!   machines' run time over one machine's (the same delay) for each k;
 //! - **real time** (`--realtime`, factor 1): each cut edge's age of
-//!   information (mean and largest; `summary.json` keeps no quantiles) and
+//!   information (median, 99th percentile, mean and largest) and
 //!   the share of its states delivered, beside the local links' mean age:
 //!   a value waits for the stage that uses it on every link alike, so the
 //!   difference of the means is what crossing adds.
@@ -231,14 +231,20 @@ pub fn tables(f: &Figures) -> String {
             two.1 / one.1
         ));
     }
-    s.push_str("\n### Real time: the cut edges\n\n");
-    s.push_str("| link | age of information, mean µs | largest µs | delivered |\n");
-    s.push_str("|---|---:|---:|---:|\n");
-    for (l, _) in f.realtime.iter().filter(|(_, cut)| *cut) {
+    s.push_str("\n### Real time: every link\n\n");
+    s.push_str(
+        "| link | cut | age of information, p50 µs | p99 µs | mean µs | largest µs | delivered |\n",
+    );
+    s.push_str("|---|---|---:|---:|---:|---:|---:|\n");
+    let us = |q: Option<f64>| q.map_or("–".to_string(), |q| format!("{:.0}", q * 1e6));
+    for (l, cut) in &f.realtime {
         s.push_str(&format!(
-            "| {} → {} | {:.0} | {:.0} | {:.2} % |\n",
+            "| {} → {} | {} | {} | {} | {:.0} | {:.0} | {:.2} % |\n",
             l.from,
             l.to,
+            if *cut { "yes" } else { "no" },
+            us(l.aoi_p50),
+            us(l.aoi_p99),
             l.aoi_mean * 1e6,
             l.aoi_max * 1e6,
             100.0 * l.delivered as f64 / l.sent.max(1) as f64
@@ -256,6 +262,23 @@ pub fn tables(f: &Figures) -> String {
         "\nMean age: {cut:.0} µs over {n_cut} cut edges, {local:.0} µs over {n_local} local links: \
          crossing adds {:.0} µs.\n",
         cut - local
+    ));
+    let p = |cut: bool, q: fn(&LinkSummary) -> Option<f64>| {
+        median(
+            (f.realtime.iter())
+                .filter(|(_, c)| *c == cut)
+                .filter_map(|(l, _)| q(l).map(|v| v * 1e6)),
+        )
+    };
+    let (p50, p99) = (|l: &LinkSummary| l.aoi_p50, |l: &LinkSummary| l.aoi_p99);
+    s.push_str(&format!(
+        "Median over the links of their p50: {:.0} µs cut, {:.0} µs local (crossing adds {:.0} µs); \
+         of their p99: {:.0} µs cut, {:.0} µs local.\n",
+        p(true, p50),
+        p(false, p50),
+        p(true, p50) - p(false, p50),
+        p(true, p99),
+        p(false, p99)
     ));
     s
 }

@@ -181,8 +181,10 @@ fn a_bundle_that_is_not_states_of_its_links_is_named() {
 struct Picky(std::sync::Arc<std::sync::Mutex<Vec<u64>>>);
 
 impl Direct for Picky {
-    fn try_now(&self, state: &[u8]) -> Result<bool, String> {
-        let step = StateMsg::from_bytes(state).map_err(|e| e.to_string())?.step;
+    fn try_now(&self, state: &[u8]) -> Result<bool, LinkError> {
+        let step = (StateMsg::from_bytes(state))
+            .map_err(|e| LinkError::Malformed(e.to_string()))?
+            .step;
         if step % 3 == 0 {
             return Ok(false);
         }

@@ -380,6 +380,11 @@ fn encode_link_stats(b: &mut Writer, from: u32, s: &LinkStats) {
     b.u64(56, s.evaluations);
     b.f64(64, s.age_sum);
     b.f64(72, s.age_max);
+    if let (Some(p50), Some(p99)) = (s.age_p50, s.age_p99) {
+        b.u32(20, 1);
+        b.f64(80, p50);
+        b.f64(88, p99);
+    }
 }
 
 fn decode_link_stats(b: &Reader) -> Telemetry {
@@ -393,6 +398,8 @@ fn decode_link_stats(b: &Reader) -> Telemetry {
             evaluations: b.u64(56),
             age_sum: b.f64(64),
             age_max: b.f64(72),
+            age_p50: (b.u32(20) == 1).then(|| b.f64(80)),
+            age_p99: (b.u32(20) == 1).then(|| b.f64(88)),
         },
     }
 }
@@ -575,6 +582,16 @@ mod tests {
                     age_max: 1e-3,
                     evaluations: 160_000,
                     rejected: u64::MAX,
+                    age_p50: None,
+                    age_p99: None,
+                },
+            },
+            Telemetry::LinkStats {
+                from: 3,
+                stats: LinkStats {
+                    age_p50: Some(1.25e-4),
+                    age_p99: Some(9.5e-4),
+                    ..LinkStats::default()
                 },
             },
             Telemetry::Done(Done {

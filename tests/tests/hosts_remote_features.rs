@@ -152,6 +152,11 @@ fn realtime_across_hosts_reports_every_link_with_its_age_of_information() {
             panic!("no age of information: {l}");
         };
         assert!(mean > 0.0 && mean <= max && max.is_finite(), "{l}");
+        let (p50, p99) = (l["aoi_p50"].as_f64(), l["aoi_p99"].as_f64());
+        let (Some(p50), Some(p99)) = (p50, p99) else {
+            panic!("no quantiles of the age of information: {l}");
+        };
+        assert!(0.0 < p50 && p50 <= p99 && p99 <= max * 1.032, "{l}");
     }
     assert_hosts_clean(&[&a, &b]);
 }

@@ -39,6 +39,12 @@ fn realtime_runs_and_measures_a_nonzero_age_of_information() {
         assert!(mean > 0.0 && mean <= max, "{l}");
         // Shared memory on one machine: far below a second.
         assert!(max < 0.5, "{l}");
+        // The quantiles are a histogram's bins (within 3.2 %) of the same ages.
+        let (p50, p99) = (
+            l["aoi_p50"].as_f64().expect("aoi_p50"),
+            l["aoi_p99"].as_f64().expect("aoi_p99"),
+        );
+        assert!(0.0 < p50 && p50 <= p99 && p99 <= max * 1.032, "{l}");
     }
     for a in s["agents"].as_array().unwrap() {
         assert!(a["late_stages"].is_u64(), "{a}");

@@ -24,6 +24,7 @@
 //! - `lockstep.rs`, `realtime.rs`: the two stepping loops.
 //! - here: [`Stepper`], [`NodeError`], the phases around the loops.
 
+mod ages;
 mod hooks;
 mod lockstep;
 mod lookahead;
@@ -300,6 +301,8 @@ pub(crate) struct Inputs {
     rejected: Vec<u64>,
     /// Per input: counters measured by the runtime (real-time mode).
     measured: Vec<LinkStats>,
+    /// Per input: the ages of information measured (real-time mode).
+    ages: Vec<ages::Ages>,
     /// Whether `measured` is reported.
     report_measured: bool,
 }
@@ -309,6 +312,7 @@ impl Inputs {
         Self {
             rejected: vec![0; cfg.inputs.len()],
             measured: vec![LinkStats::default(); cfg.inputs.len()],
+            ages: vec![ages::Ages::default(); cfg.inputs.len()],
             report_measured: cfg.realtime.is_some(),
         }
     }

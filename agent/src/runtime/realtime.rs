@@ -110,11 +110,13 @@ pub(crate) fn run<S: Service, N: Stepper, H: Hooks>(
             after_step(io, cfg, stepper, slot.step + 1)?;
         }
     }
-    for st in &mut inputs.measured {
+    for (st, ages) in inputs.measured.iter_mut().zip(&inputs.ages) {
         // Every node makes the same exchanges: what a sender sent is what we made.
         *st = LinkStats {
             sent: exchanges,
             lost: exchanges.saturating_sub(st.delivered),
+            age_p50: ages.quantile(0.5),
+            age_p99: ages.quantile(0.99),
             ..*st
         };
     }
@@ -219,6 +221,7 @@ fn exchange<S: Service, N: Stepper, H: Hooks>(
             st.age_sum += age;
             st.age_max = st.age_max.max(age);
             st.evaluations += 1;
+            inputs.ages[k].record(age);
         }
     }
     Ok(())

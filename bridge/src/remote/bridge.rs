@@ -14,7 +14,7 @@ use super::Side;
 pub use super::bridge_error::BridgeError;
 use super::bridge_error::debug;
 use super::keys;
-use super::link::{Flow, Window};
+use super::link::{Flow, LinkError, Window};
 use super::local::{LocalNs, Shared};
 use super::mesh::Sessions;
 use super::trunk::{BUNDLE_MOST, Direct, TrunkInput, TrunkReceiver, TrunkSender};
@@ -417,8 +417,8 @@ thread_local! {
 impl Direct for Republisher {
     /// With one receiver: a send that cannot deliver at once fails having
     /// reached nobody, and the state goes to the link's thread.
-    fn try_now(&self, state: &[u8]) -> Result<bool, String> {
-        let m = StateMsg::from_bytes(state).map_err(|e| e.to_string())?;
+    fn try_now(&self, state: &[u8]) -> Result<bool, LinkError> {
+        let m = StateMsg::from_bytes(state).map_err(|e| LinkError::Malformed(e.to_string()))?;
         AT_ONCE.set(true);
         let sent = self.publisher.send_copy(m);
         AT_ONCE.set(false);

@@ -82,6 +82,10 @@ pub enum LinkError {
     /// The run is ending.
     #[error("stopped")]
     Stopped,
+    /// What arrived is not what the link carries (not a whole number of
+    /// states, a sender it does not carry, a state that cannot be read).
+    #[error("received {0}")]
+    Malformed(String),
 }
 
 fn zerr(e: impl std::fmt::Display) -> LinkError {

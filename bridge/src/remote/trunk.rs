@@ -156,7 +156,7 @@ fn book_ack(acked: &Acked, senders: &[u32], bytes: &[u8]) {
 pub trait Direct: Send + Sync {
     /// `Ok(true)`: delivered; `Ok(false)`: not now (the link's thread will);
     /// `Err`: the state cannot be delivered, why.
-    fn try_now(&self, state: &[u8]) -> Result<bool, String>;
+    fn try_now(&self, state: &[u8]) -> Result<bool, LinkError>;
 }
 
 /// One link's inbox: its states in order, at most `depth` (a window's
@@ -172,7 +172,7 @@ struct Inbox {
 impl Inbox {
     /// Delivers `state` from the callback if it is first in line and goes
     /// at once (`q`: the locked queue).
-    fn direct(&self, q: &VecDeque<Vec<u8>>, state: &[u8]) -> Result<bool, String> {
+    fn direct(&self, q: &VecDeque<Vec<u8>>, state: &[u8]) -> Result<bool, LinkError> {
         let Some(d) = self.direct.get() else {
             return Ok(false);
         };
@@ -204,12 +204,14 @@ impl Shared {
     /// Sorts a bundle's states into their inboxes (the Zenoh callback).
     fn sort(&self, bundle: &[u8]) {
         if bundle.len() % StateMsg::SIZE != 0 {
-            return self.fault(format!("a bundle of {} bytes", bundle.len()));
+            let what = format!("a bundle of {} bytes", bundle.len());
+            return self.fault(LinkError::Malformed(what));
         }
         for state in bundle.chunks_exact(StateMsg::SIZE) {
             let Some(i) = sender_of(state).and_then(|s| self.senders.iter().position(|&x| x == s))
             else {
-                return self.fault(format!("a state of sender {:?}", sender_of(state)));
+                let what = format!("a state of sender {:?}", sender_of(state));
+                return self.fault(LinkError::Malformed(what));
             };
             let inbox = &self.inboxes[i];
             let mut q = lock(&inbox.queue);
@@ -218,7 +220,7 @@ impl Shared {
                 Ok(true) => {
                     drop(q);
                     if let Err(e) = self.book(i) {
-                        return self.fault(e.to_string());
+                        return self.fault(e);
                     }
                     continue;
                 }
@@ -230,7 +232,8 @@ impl Shared {
             if q.len() >= self.depth {
                 if self.lossless {
                     drop(q);
-                    return self.fault(format!("node {}'s window overrun", self.senders[i]));
+                    let what = format!("node {}'s states beyond its window", self.senders[i]);
+                    return self.fault(LinkError::Malformed(what));
                 }
                 q.pop_front();
             }
@@ -239,8 +242,8 @@ impl Shared {
         }
     }
 
-    fn fault(&self, what: String) {
-        lock(&self.fault).get_or_insert(LinkError::Zenoh(format!("trunk received {what}")));
+    fn fault(&self, e: LinkError) {
+        lock(&self.fault).get_or_insert(e);
         for i in &self.inboxes {
             i.ready.notify_all();
         }

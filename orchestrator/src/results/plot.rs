@@ -596,6 +596,8 @@ mod tests {
             lost: 0,
             aoi_mean: mean,
             aoi_max: max,
+            aoi_p50: None,
+            aoi_p99: None,
             rejected: 0,
         };
         let links = [link(0, 1, 1e-3, 2e-3), link(1, 2, 5e-4, f64::NAN)];

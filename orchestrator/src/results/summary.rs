@@ -113,6 +113,13 @@ pub struct LinkSummary {
     /// Largest age of information, s.
     #[serde(deserialize_with = "f64_or_nan")]
     pub aoi_max: f64,
+    /// Median age of information, s, where measured (real time, within
+    /// 3.2 %: a histogram's bin).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aoi_p50: Option<f64>,
+    /// 99th percentile of the age of information, s, likewise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub aoi_p99: Option<f64>,
     /// Messages the receiver refused (non-finite values, or an attitude that
     /// is not a rotation); it kept its previous value instead.
     #[serde(default)]
@@ -284,6 +291,8 @@ impl LinkSummary {
                 0.0
             },
             aoi_max: st.age_max,
+            aoi_p50: st.age_p50,
+            aoi_p99: st.age_p99,
             rejected: st.rejected,
         }
     }
@@ -373,11 +382,15 @@ impl Summary {
     /// A line per listed link.
     fn write_links(&self, s: &mut String) {
         for l in &self.links {
-            let _ = writeln!(
+            let _ = write!(
                 s,
                 "link {:>3} → {:<3} sent {:>8} delivered {:>8} lost {:>7} rejected {:>5} AoI mean {:.3e} s max {:.3e} s",
                 l.from, l.to, l.sent, l.delivered, l.lost, l.rejected, l.aoi_mean, l.aoi_max
             );
+            if let (Some(p50), Some(p99)) = (l.aoi_p50, l.aoi_p99) {
+                let _ = write!(s, " p50 {p50:.3e} s p99 {p99:.3e} s");
+            }
+            s.push('\n');
         }
     }
 
