@@ -191,6 +191,8 @@ impl Direct for Picky {
         self.0.lock().unwrap().push(step);
         Ok(true)
     }
+
+    fn wake(&self) {}
 }
 
 #[test]

@@ -56,8 +56,9 @@ impl Bridges {
         let mut threads = Vec::new();
         for (s, out) in outgoing(sessions, me, links) {
             let (ns, run, sh) = (ns.clone(), run.to_string(), shared.clone());
+            let all = links.to_vec();
             threads.push(std::thread::spawn(move || {
-                if let Err(e) = send_states(&s, &ns, &run, &out, &sh) {
+                if let Err(e) = send_states(&s, &ns, &run, (&out, &all), &sh) {
                     sh.fail(format!(
                         "bridge of the states leaving {}: {e}",
                         out[0].from_side
@@ -173,20 +174,73 @@ impl Outgoing {
     }
 }
 
-/// The links towards one side: their trunk and their sending ends, in the
-/// trunk's order.
+/// The links towards one side: their trunk, their sending ends (in the
+/// trunk's order) and how long their states may wait to share a bundle.
 struct Towards {
     trunk: TrunkSender,
     links: Vec<Outgoing>,
+    hold: Hold,
+}
+
+/// How long states may wait for others to share their bundle: never in
+/// lockstep without lookahead (each crossing is on the run's path); when
+/// every link leaving this side and every link reaching it is delayed by
+/// at least `ahead` ≥ 1 steps (so a sender here runs at least that far
+/// ahead of its receivers there, whatever path leads back), until a link
+/// has half of that lead (2·ahead states) or the first has waited
+/// [`HOLD_MOST`]. Holding changes when states arrive, never which.
+struct Hold {
+    /// States a link may gather: 0 to send at once.
+    gather: usize,
+    /// When the oldest state not sent was read.
+    since: Option<std::time::Instant>,
+}
+
+/// The longest a state waits for others to share its bundle.
+const HOLD_MOST: Duration = Duration::from_micros(500);
+
+impl Hold {
+    /// The hold of `links` on side `me`, whose run's links are `all`.
+    fn of(links: &[&StateLink], me: &Side, all: &[StateLink], most: usize) -> Self {
+        let back = (all.iter().filter(|l| l.to_side == *me)).map(|l| l.ahead);
+        let ahead = (links.iter().map(|l| l.ahead).chain(back))
+            .min()
+            .unwrap_or(0);
+        let gather = usize::try_from(ahead.saturating_mul(2)).unwrap_or(usize::MAX);
+        Self {
+            gather: gather.min(most / 2),
+            since: None,
+        }
+    }
+
+    /// How long states queued so (per link) may still wait (`None`: send now).
+    fn left(&mut self, queued: &[usize]) -> Option<Duration> {
+        if queued.iter().all(|&n| n == 0) {
+            self.since = None;
+            return None;
+        }
+        let since = *self.since.get_or_insert_with(std::time::Instant::now);
+        if queued.iter().any(|&n| n >= self.gather) {
+            return None;
+        }
+        HOLD_MOST
+            .checked_sub(since.elapsed())
+            .filter(|d| !d.is_zero())
+    }
 }
 
 impl Towards {
     /// Reads every link and sends what their windows allow, in bundles of
-    /// at most [`BUNDLE_MOST`]; whether anything moved.
-    fn pump(&mut self, most: usize) -> Result<bool, BridgeError> {
+    /// at most [`BUNDLE_MOST`], unless its states may wait for more;
+    /// whether anything moved, and how long the states left may wait.
+    fn pump(&mut self, most: usize) -> Result<(bool, Option<Duration>), BridgeError> {
         let mut moved = false;
         for o in &mut self.links {
             moved |= o.read(most)?;
+        }
+        let queued: Vec<usize> = self.links.iter().map(|o| o.queue.len()).collect();
+        if let Some(left) = self.hold.left(&queued) {
+            return Ok((moved, Some(left)));
         }
         loop {
             let mut bundle = Vec::new();
@@ -201,7 +255,8 @@ impl Towards {
                 room -= n;
             }
             if bundle.is_empty() {
-                return Ok(moved);
+                self.hold.since = None;
+                return Ok((moved, None));
             }
             self.trunk.send(bundle, &counts)?;
             moved = true;
@@ -229,12 +284,12 @@ fn state_flow(ns: &LocalNs) -> Flow {
 /// one thread that sleeps on the wake events of the receivers over there
 /// (nobody else listens to them on this side). A link without credit
 /// leaves its messages in iceoryx2 (holding its sender back) and never
-/// blocks another.
+/// blocks another. `all`: every link of the run on this side.
 fn send_states(
     session: &zenoh::Session,
     ns: &LocalNs,
     run: &str,
-    links: &[StateLink],
+    (links, all): (&[StateLink], &[StateLink]),
     sh: &Shared,
 ) -> Result<(), BridgeError> {
     let node = ns.node("bridge-out")?;
@@ -244,7 +299,7 @@ fn send_states(
         let key = keys::state_trunk(run, &group[0].from_side, &to);
         let trunk = TrunkSender::open(session, &key, senders, state_flow(ns))?;
         let mut outs = Vec::new();
-        for l in group {
+        for l in &group {
             let svc = msgs::open::state(&node, &ns.run, l.from, &ns.limits)?;
             if !publisher_is_up(&svc, sh) {
                 return Ok(()); // the run ended first
@@ -257,7 +312,12 @@ fn send_states(
                 queue: std::collections::VecDeque::new(),
             });
         }
-        towards.push(Towards { trunk, links: outs });
+        let hold = Hold::of(&group, &group[0].from_side, all, ns.limits.state_buffer);
+        towards.push(Towards {
+            trunk,
+            links: outs,
+            hold,
+        });
     }
     let listeners = wake_listeners(&node, ns, links)?;
     let waitset = WaitSetBuilder::new()
@@ -269,17 +329,19 @@ fn send_states(
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| BridgeError::WaitSet(debug(e)))?;
     let most = ns.limits.state_buffer.max(1);
+    let mut wait = SLICE;
     while !sh.stopping() {
-        let _ =
-            waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, SLICE);
+        let _ = waitset.wait_and_process_once_with_timeout(|_| CallbackProgression::Continue, wait);
         for l in &listeners {
             let _ = l.try_wait(|_| {});
         }
         let mut moved = true;
         while moved {
-            moved = false;
+            (moved, wait) = (false, SLICE);
             for t in &mut towards {
-                moved |= t.pump(most)?;
+                let (m, left) = t.pump(most)?;
+                moved |= m;
+                wait = wait.min(left.unwrap_or(SLICE));
             }
         }
     }
@@ -422,21 +484,17 @@ impl Direct for Republisher {
         AT_ONCE.set(true);
         let sent = self.publisher.send_copy(m);
         AT_ONCE.set(false);
-        if !matches!(sent, Ok(n) if n >= self.want) {
-            return Ok(false);
-        }
-        self.wake();
-        Ok(true)
+        Ok(matches!(sent, Ok(n) if n >= self.want))
     }
-}
 
-impl Republisher {
     fn wake(&self) {
         for n in &self.notifiers {
             let _ = n.notify();
         }
     }
+}
 
+impl Republisher {
     /// Publishes `m` to every local receiver and wakes them. iceoryx2 0.10
     /// skips, without an error, a receiver whose buffer is full while its
     /// side of the connection is not established yet (it connects when it
@@ -492,5 +550,55 @@ fn hold_back(
             std::thread::sleep(Duration::from_micros(50));
             iceoryx2::port::BackpressureAction::Retry
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn link(from: u32, from_side: Side, to_side: Side, ahead: u64) -> StateLink {
+        StateLink {
+            from,
+            from_side,
+            to_side,
+            receivers: vec![9],
+            ahead,
+        }
+    }
+
+    #[test]
+    fn states_wait_only_when_every_link_in_and_out_is_delayed() {
+        let (me, there) = (Side::Orchestrator, Side::Host("b".into()));
+        let out = link(1, me.clone(), there.clone(), 3);
+        let all = |back: u64| vec![out.clone(), link(2, there.clone(), me.clone(), back)];
+        // an undelayed link back: the sender may wait for what it sends
+        assert_eq!(Hold::of(&[&out], &me, &all(0), 64).gather, 0);
+        assert_eq!(Hold::of(&[&out], &me, &all(5), 64).gather, 6);
+        assert_eq!(Hold::of(&[&out], &me, &all(1), 64).gather, 2);
+        assert_eq!(Hold::of(&[&out], &me, &all(50), 64).gather, 6);
+        let far = link(1, me.clone(), there.clone(), 100);
+        assert_eq!(Hold::of(&[&far], &me, std::slice::from_ref(&far), 64).gather, 32);
+    }
+
+    #[test]
+    fn a_hold_ends_when_a_link_has_gathered_or_its_time_is_up() {
+        let mut h = Hold {
+            gather: 4,
+            since: None,
+        };
+        assert_eq!(h.left(&[0, 0]), None);
+        let wait = h.left(&[1, 0]).expect("waits");
+        assert!(wait <= HOLD_MOST);
+        assert_eq!(h.left(&[4, 1]), None, "a link gathered enough");
+        std::thread::sleep(HOLD_MOST);
+        assert_eq!(h.left(&[1, 1]), None, "time is up");
+        assert_eq!(h.left(&[0, 0]), None);
+        assert!(h.since.is_none(), "nothing queued: the clock restarts");
+        let mut never = Hold {
+            gather: 0,
+            since: None,
+        };
+        assert_eq!(never.left(&[1]), None, "no lookahead: send at once");
     }
 }

@@ -195,6 +195,7 @@ mod tests {
 
     fn link(from: u32, from_side: &Side, to_side: &Side) -> StateLink {
         StateLink {
+            ahead: 0,
             from,
             from_side: from_side.clone(),
             to_side: to_side.clone(),

@@ -4,7 +4,8 @@
 
 use super::Side;
 use super::wire::StateLink;
-use msgs::config::NodeConfig;
+use attitude::agent::Agent;
+use msgs::config::{NodeConfig, Role};
 use std::collections::BTreeMap;
 
 /// A host and the nodes placed on it.
@@ -55,26 +56,42 @@ impl Plan {
 /// other machine with receivers of it (receivers ascending).
 #[must_use]
 pub fn links(configs: &[NodeConfig], plan: &Plan) -> Vec<StateLink> {
-    let mut by: BTreeMap<(u32, Side), Vec<u32>> = BTreeMap::new();
+    let mut by: BTreeMap<(u32, Side), (Vec<u32>, u64)> = BTreeMap::new();
     for c in configs {
         let to = plan.side_of(c.id);
-        for &from in &c.inputs {
+        for (&from, ahead) in c.inputs.iter().zip(lookahead(c)) {
             if plan.side_of(from) != to {
-                by.entry((from, to.clone())).or_default().push(c.id);
+                let (receivers, least) = by.entry((from, to.clone())).or_insert((vec![], ahead));
+                receivers.push(c.id);
+                *least = (*least).min(ahead);
             }
         }
     }
     (by.into_iter())
-        .map(|((from, to_side), mut receivers)| {
+        .map(|((from, to_side), (mut receivers, ahead))| {
             receivers.sort_unstable();
             StateLink {
                 from,
                 from_side: plan.side_of(from),
                 to_side,
                 receivers,
+                ahead,
             }
         })
         .collect()
+}
+
+/// How many steps ahead each input of `c` may be taken, as its node
+/// computes it (`Agent::lookahead`); 0 for the leader's none and for a
+/// process that takes over from a crashed one.
+fn lookahead(c: &NodeConfig) -> Vec<u64> {
+    match &c.role {
+        Role::Agent { model, initial } if c.resume.is_none() => {
+            let a = Agent::new((**model).clone(), *initial, c.dt);
+            (0..c.inputs.len()).map(|k| a.lookahead(k)).collect()
+        }
+        _ => vec![0; c.inputs.len()],
+    }
 }
 
 #[cfg(test)]

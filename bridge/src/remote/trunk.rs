@@ -154,9 +154,12 @@ fn book_ack(acked: &Acked, senders: &[u32], bytes: &[u8]) {
 /// Delivers a link's state at once from Zenoh's callback, or says it
 /// cannot without waiting.
 pub trait Direct: Send + Sync {
-    /// `Ok(true)`: delivered; `Ok(false)`: not now (the link's thread will);
-    /// `Err`: the state cannot be delivered, why.
+    /// `Ok(true)`: delivered (its receivers are woken later, once per
+    /// bundle: [`Self::wake`]); `Ok(false)`: not now (the link's thread
+    /// will); `Err`: the state cannot be delivered, why.
     fn try_now(&self, state: &[u8]) -> Result<bool, LinkError>;
+    /// Wakes the receivers of the states delivered.
+    fn wake(&self);
 }
 
 /// One link's inbox: its states in order, at most `depth` (a window's
@@ -201,45 +204,52 @@ struct Shared {
 }
 
 impl Shared {
-    /// Sorts a bundle's states into their inboxes (the Zenoh callback).
+    /// Sorts a bundle's states into their inboxes (the Zenoh callback);
+    /// the receivers of states delivered directly are woken once, after.
     fn sort(&self, bundle: &[u8]) {
         if bundle.len() % StateMsg::SIZE != 0 {
             let what = format!("a bundle of {} bytes", bundle.len());
             return self.fault(LinkError::Malformed(what));
         }
+        let mut direct = vec![false; self.inboxes.len()];
         for state in bundle.chunks_exact(StateMsg::SIZE) {
             let Some(i) = sender_of(state).and_then(|s| self.senders.iter().position(|&x| x == s))
             else {
                 let what = format!("a state of sender {:?}", sender_of(state));
                 return self.fault(LinkError::Malformed(what));
             };
-            let inbox = &self.inboxes[i];
-            let mut q = lock(&inbox.queue);
-            match inbox.direct(&q, state) {
-                Ok(false) => {}
-                Ok(true) => {
-                    drop(q);
-                    if let Err(e) = self.book(i) {
-                        return self.fault(e);
-                    }
-                    continue;
-                }
-                Err(e) => {
-                    drop(q);
-                    return self.fault(e);
-                }
+            match self.place(i, state) {
+                Ok(d) => direct[i] |= d,
+                Err(e) => return self.fault(e),
             }
-            if q.len() >= self.depth {
-                if self.lossless {
-                    drop(q);
-                    let what = format!("node {}'s states beyond its window", self.senders[i]);
-                    return self.fault(LinkError::Malformed(what));
-                }
-                q.pop_front();
-            }
-            q.push_back(state.to_vec());
-            inbox.ready.notify_one();
         }
+        for (inbox, _) in self.inboxes.iter().zip(direct).filter(|(_, d)| *d) {
+            if let Some(d) = inbox.direct.get() {
+                d.wake();
+            }
+        }
+    }
+
+    /// Delivers link `i`'s `state` directly (`true`) or queues it for its
+    /// thread.
+    fn place(&self, i: usize, state: &[u8]) -> Result<bool, LinkError> {
+        let inbox = &self.inboxes[i];
+        let mut q = lock(&inbox.queue);
+        if inbox.direct(&q, state)? {
+            drop(q);
+            self.book(i)?;
+            return Ok(true);
+        }
+        if q.len() >= self.depth {
+            if self.lossless {
+                let what = format!("node {}'s states beyond its window", self.senders[i]);
+                return Err(LinkError::Malformed(what));
+            }
+            q.pop_front();
+        }
+        q.push_back(state.to_vec());
+        inbox.ready.notify_one();
+        Ok(false)
     }
 
     fn fault(&self, e: LinkError) {

@@ -54,6 +54,11 @@ pub struct StateLink {
     pub to_side: Side,
     /// The receivers there, ascending.
     pub receivers: Vec<u32>,
+    /// How many steps ahead of its receivers there the sender may run:
+    /// the least lookahead of this input among them (its link's delay,
+    /// PROTOCOL § 10.9); 0 (lockstep) when absent.
+    #[serde(default)]
+    pub ahead: u64,
 }
 
 /// A run offered to a host (`attsync/host/<name>/run`): the host fetches
