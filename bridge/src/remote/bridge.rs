@@ -578,7 +578,10 @@ mod tests {
         assert_eq!(Hold::of(&[&out], &me, &all(1), 64).gather, 2);
         assert_eq!(Hold::of(&[&out], &me, &all(50), 64).gather, 6);
         let far = link(1, me.clone(), there.clone(), 100);
-        assert_eq!(Hold::of(&[&far], &me, std::slice::from_ref(&far), 64).gather, 32);
+        assert_eq!(
+            Hold::of(&[&far], &me, std::slice::from_ref(&far), 64).gather,
+            32
+        );
     }
 
     #[test]
